@@ -1,0 +1,164 @@
+"""Basic motion on odometry: drive a distance, rotate by an angle, drive to a point, stop.
+
+Each behaviour writes a :class:`~drivers.interfaces.VelocityCommand` to ``/robot/command`` every
+tick it runs; the runner clears the command before each tick, so a finished or halted behaviour
+leaves the robot commanded to rest. Speeds ramp down as ``sqrt(2 a d)`` near the end so the base
+stops on target within its deceleration limit instead of overshooting.
+"""
+
+from __future__ import annotations
+
+import math
+
+from py_trees.common import Status
+
+from behaviours.base import BearingsBehaviour
+from behaviours.ports import Param
+from behaviours.registry import register
+from drivers.interfaces import STOP, VelocityCommand
+from perception.geometry import Pose2D, wrap_angle
+
+LINEAR_DECEL = 0.25  # m/s^2, below the Pioneer's 0.3 so the ramp is always achievable
+ANGULAR_DECEL = math.radians(80.0)  # rad/s^2, below the Pioneer's 100 deg/s^2
+MIN_SPEED = 0.02  # m/s, so the last millimetres do not take forever
+MIN_TURN = math.radians(2.0)  # rad/s
+HEADING_GAIN = 1.5  # 1/s, holds the heading while driving straight
+
+
+def ramp(remaining: float, top: float, decel: float, floor: float) -> float:
+    """Speed for ``remaining`` distance (signed): capped at ``top``, able to stop in time."""
+    speed = min(top, math.sqrt(2.0 * decel * abs(remaining)))
+    return math.copysign(max(speed, floor), remaining)
+
+
+class _OdometryMotion(BearingsBehaviour):
+    READS = ("/robot/odometry", "/robot/stalled")
+    WRITES = ("/robot/command",)
+
+    def odometry(self) -> Pose2D | None:
+        return self.read("/robot/odometry")
+
+    def command(self, v: float, w: float) -> None:
+        self.write("/robot/command", VelocityCommand(v, w))
+
+    def blocked(self) -> bool:
+        if self.read("/robot/stalled", False):
+            self.command(0.0, 0.0)
+            self.feedback_message = "stalled"
+            return True
+        return False
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status != Status.RUNNING:
+            self.write("/robot/command", STOP)
+
+
+@register
+class Drive(_OdometryMotion):
+    """Drive straight ``distance`` metres (negative: backwards), holding the starting heading."""
+
+    PARAMS = (
+        Param("distance", "float", unit="m", doc="signed distance along the starting heading"),
+        Param("speed", "float", 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2),
+        Param("tolerance", "float", 0.01, unit="m", doc="close enough", minimum=0.001),
+    )
+
+    def initialise(self) -> None:
+        self._start: Pose2D | None = self.odometry()
+
+    def update(self) -> Status:
+        pose = self.odometry()
+        if pose is None:
+            self.feedback_message = "waiting for odometry"
+            return Status.RUNNING
+        if self._start is None:
+            self._start = pose
+        if self.blocked():
+            return Status.FAILURE
+        start = self._start
+        travelled = (pose.x - start.x) * math.cos(start.theta) + (pose.y - start.y) * math.sin(start.theta)
+        remaining = float(self.param("distance")) - travelled
+        if abs(remaining) <= float(self.param("tolerance")):
+            self.command(0.0, 0.0)
+            return Status.SUCCESS
+        v = ramp(remaining, float(self.param("speed")), LINEAR_DECEL, MIN_SPEED)
+        w = -HEADING_GAIN * wrap_angle(pose.theta - start.theta)
+        self.command(v, w)
+        self.feedback_message = f"{remaining:+.2f} m to go"
+        return Status.RUNNING
+
+
+@register
+class Rotate(_OdometryMotion):
+    """Turn on the spot by ``angle`` degrees (positive: counter-clockwise)."""
+
+    PARAMS = (
+        Param("angle", "float", unit="deg", doc="signed angle to turn"),
+        Param("speed", "float", 45.0, unit="deg/s", doc="top turn rate", minimum=1.0, maximum=300.0),
+        Param("tolerance", "float", 1.0, unit="deg", doc="close enough", minimum=0.05),
+    )
+
+    def initialise(self) -> None:
+        self._last: float | None = None
+        self._turned = 0.0
+
+    def update(self) -> Status:
+        pose = self.odometry()
+        if pose is None:
+            self.feedback_message = "waiting for odometry"
+            return Status.RUNNING
+        if self.blocked():
+            return Status.FAILURE
+        if self._last is not None:
+            self._turned += wrap_angle(pose.theta - self._last)  # unwrapped: angles beyond 180 deg work
+        self._last = pose.theta
+        remaining = math.radians(float(self.param("angle"))) - self._turned
+        if abs(remaining) <= math.radians(float(self.param("tolerance"))):
+            self.command(0.0, 0.0)
+            return Status.SUCCESS
+        w = ramp(remaining, math.radians(float(self.param("speed"))), ANGULAR_DECEL, MIN_TURN)
+        self.command(0.0, w)
+        self.feedback_message = f"{math.degrees(remaining):+.1f} deg to go"
+        return Status.RUNNING
+
+
+@register
+class DriveTo(_OdometryMotion):
+    """Drive to the point (x, y) of the odometry frame: turn towards it, then drive while steering."""
+
+    PARAMS = (
+        Param("x", "float", unit="m", doc="goal x in the odometry frame"),
+        Param("y", "float", unit="m", doc="goal y in the odometry frame"),
+        Param("speed", "float", 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2),
+        Param("tolerance", "float", 0.05, unit="m", doc="goal radius", minimum=0.005),
+    )
+    TURN_IN_PLACE = math.radians(30.0)  # heading error above which the robot turns before driving
+
+    def update(self) -> Status:
+        pose = self.odometry()
+        if pose is None:
+            self.feedback_message = "waiting for odometry"
+            return Status.RUNNING
+        if self.blocked():
+            return Status.FAILURE
+        dx, dy = float(self.param("x")) - pose.x, float(self.param("y")) - pose.y
+        distance = math.hypot(dx, dy)
+        if distance <= float(self.param("tolerance")):
+            self.command(0.0, 0.0)
+            return Status.SUCCESS
+        error = wrap_angle(math.atan2(dy, dx) - pose.theta)
+        w = ramp(error, math.radians(60.0), ANGULAR_DECEL, 0.0) if error else 0.0
+        v = 0.0 if abs(error) > self.TURN_IN_PLACE else ramp(distance, float(self.param("speed")),
+                                                              LINEAR_DECEL, MIN_SPEED) * math.cos(error)
+        self.command(v, w)
+        self.feedback_message = f"{distance:.2f} m to go"
+        return Status.RUNNING
+
+
+@register
+class Stop(_OdometryMotion):
+    """Command the base to rest; SUCCESS at once."""
+
+    def update(self) -> Status:
+        self.command(0.0, 0.0)
+        return Status.SUCCESS

@@ -1,0 +1,78 @@
+"""The data-gathering branch: driver readings onto the blackboard, once per tick.
+
+These are the only behaviours that touch a driver, and only through the interfaces of the
+:class:`~drivers.interfaces.Robot` handed to the tree at setup (``setup(robot=...)``). They are
+the single writers of the ``sense`` keys of :mod:`behaviours.keys`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from py_trees.common import Status
+
+from behaviours.base import BearingsBehaviour, NotSetUp
+from behaviours.registry import register
+from drivers.interfaces import Robot
+
+
+class _Sensor(BearingsBehaviour):
+    def setup(self, **kwargs: Any) -> None:
+        super().setup(**kwargs)
+        self._robot: Robot | None = kwargs.get("robot", getattr(self, "_robot", None))
+
+    @property
+    def robot(self) -> Robot:
+        if getattr(self, "_robot", None) is None:
+            raise NotSetUp(f"{self.name}: no robot; set the tree up with setup(robot=...)")
+        return self._robot
+
+
+@register
+class ReadOdometry(_Sensor):
+    """Copy the base's odometry and stall flag to ``/robot``."""
+
+    WRITES = ("/robot/odometry", "/robot/stalled")
+
+    def update(self) -> Status:
+        base = self.robot.base
+        self.write("/robot/odometry", base.odometry())
+        self.write("/robot/stalled", bool(base.stalled()))
+        return Status.SUCCESS
+
+
+@register
+class ReadPanTilt(_Sensor):
+    """Copy the pan-tilt unit's state to ``/ptu/state`` (SUCCESS without doing anything if none)."""
+
+    WRITES = ("/ptu/state",)
+
+    def update(self) -> Status:
+        if self.robot.ptu is not None:
+            self.write("/ptu/state", self.robot.ptu.state())
+        return Status.SUCCESS
+
+
+@register
+class GrabFrames(_Sensor):
+    """Grab one frame per camera into ``/perception/frames``; the first camera's also into ``frame``.
+
+    A dropped frame keeps the previous one (its stamp tells how old it is).
+    """
+
+    WRITES = ("/perception/frames", "/perception/frame")
+
+    def update(self) -> Status:
+        cameras = self.robot.cameras
+        if not cameras:
+            return Status.SUCCESS
+        frames = dict(self.read("/perception/frames") or {})
+        for name, camera in cameras.items():
+            frame = camera.grab()
+            if frame is not None:
+                frames[name] = frame
+        self.write("/perception/frames", frames)
+        primary = next(iter(cameras))
+        if primary in frames:
+            self.write("/perception/frame", frames[primary])
+        return Status.SUCCESS

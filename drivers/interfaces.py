@@ -1,0 +1,126 @@
+"""The interfaces every driver implements, and the values that cross them.
+
+Real hardware (Pioneer over ARCOS, PTU-D46) and the simulator implement the same protocols, so a
+mission cannot tell them apart. Units are SI: metres, seconds, radians.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
+
+from perception.frame import Frame
+from perception.geometry import Pose2D
+
+
+@dataclass(frozen=True, slots=True)
+class VelocityCommand:
+    """A body-frame velocity request: ``v`` forward (m/s), ``w`` counter-clockwise (rad/s)."""
+
+    v: float = 0.0
+    w: float = 0.0
+
+    @property
+    def is_zero(self) -> bool:
+        return self.v == 0.0 and self.w == 0.0
+
+
+STOP = VelocityCommand(0.0, 0.0)
+
+
+@dataclass(frozen=True, slots=True)
+class PanTiltState:
+    """Where the pan-tilt unit points (rad) and whether it is still moving."""
+
+    pan: float = 0.0
+    tilt: float = 0.0
+    moving: bool = False
+    stamp: float = 0.0
+
+
+@dataclass(frozen=True, slots=True)
+class PanTiltCommand:
+    """Absolute pan/tilt target (rad) and the slew speed (rad/s) to reach it with."""
+
+    pan: float
+    tilt: float
+    speed: float = 1.0
+
+
+@runtime_checkable
+class Base(Protocol):
+    """A differential-drive base."""
+
+    def drive(self, v: float, w: float) -> None:
+        """Request forward speed ``v`` (m/s) and turn rate ``w`` (rad/s) until the next call."""
+
+    def stop(self) -> None:
+        """Bring the base to rest now; must be safe to call at any time, repeatedly."""
+
+    def odometry(self) -> Pose2D:
+        """The latest odometry pose in the odometry frame (drifts; never ground truth)."""
+
+    def stalled(self) -> bool:
+        """True while a wheel is stalled (collision, obstacle)."""
+
+    def close(self) -> None:
+        """Release the device; the base must be stopped before."""
+
+
+@runtime_checkable
+class PanTilt(Protocol):
+    """A pan-tilt unit carrying cameras."""
+
+    def move(self, pan: float, tilt: float, speed: float) -> None:
+        """Start moving to an absolute pan/tilt (rad) at ``speed`` (rad/s); returns at once."""
+
+    def halt(self) -> None:
+        """Stop moving where it is."""
+
+    def state(self) -> PanTiltState:
+        """Current position and motion flag."""
+
+    def close(self) -> None:
+        """Release the device."""
+
+
+@runtime_checkable
+class Camera(Protocol):
+    """A camera (or rectified stereo pair) that yields frames."""
+
+    name: str
+
+    def grab(self) -> Frame | None:
+        """The newest frame, or None when the camera dropped it."""
+
+    def close(self) -> None:
+        """Release the device."""
+
+
+@dataclass
+class Robot:
+    """The set of drivers one mission runs with, built by the runner from a profile."""
+
+    base: Base
+    ptu: PanTilt | None = None
+    cameras: dict[str, Camera] = field(default_factory=dict)
+    name: str = "robot"
+
+    def stop_all(self) -> None:
+        """Command every actuator to rest; never raises so it can run on any error path."""
+        for stop in (self.base.stop, self.ptu.halt if self.ptu is not None else None):
+            if stop is None:
+                continue
+            with contextlib.suppress(Exception):  # safety path: try every actuator regardless
+                stop()
+
+    def close(self) -> None:
+        """Stop, then release every device (cameras, pan-tilt, base last)."""
+        self.stop_all()
+        devices = [*self.cameras.values(), self.ptu, self.base]
+        for device in devices:
+            if device is None:
+                continue
+            with contextlib.suppress(Exception):  # keep closing the others
+                device.close()

@@ -1,0 +1,1 @@
+"""The built-in simulator: the embedded default robot, deterministic for a seed."""

@@ -1,0 +1,258 @@
+"""The one place that reads files named by the user and writes files atomically.
+
+Reading: YAML is parsed with PyYAML's *safe* loader and every mapping and sequence remembers the
+line and column of each entry, so validators anywhere can report ``file:line:col: message``.
+Writing: a temporary file in the same directory, flushed and fsynced, then renamed over the
+target, so a crash never leaves a half-written map, calibration or report.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import tempfile
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    """One problem in an input file, located at a 1-based line and column (0: unknown)."""
+
+    file: str
+    line: int
+    col: int
+    message: str
+
+    def __str__(self) -> str:
+        if self.line <= 0:
+            return f"{self.file}: {self.message}"
+        return f"{self.file}:{self.line}:{self.col}: {self.message}"
+
+
+class InputError(Exception):
+    """Invalid user input: one or more located diagnostics, reported together (exit code 2)."""
+
+    def __init__(self, diagnostics: Iterable[Diagnostic]) -> None:
+        self.diagnostics = list(diagnostics)
+        super().__init__("\n".join(str(d) for d in self.diagnostics))
+
+
+@dataclass(frozen=True, slots=True)
+class Mark:
+    """Where a YAML value starts: 1-based line and column."""
+
+    line: int
+    col: int
+
+
+class YamlMap(dict):
+    """A dict that remembers where it and each of its keys and values start in the file."""
+
+    mark: Mark
+    key_marks: dict[Any, Mark]
+    value_marks: dict[Any, Mark]
+
+    def mark_of(self, key: Any) -> Mark:
+        return self.key_marks.get(key, self.mark)
+
+    def value_mark_of(self, key: Any) -> Mark:
+        return self.value_marks.get(key, self.mark_of(key))
+
+
+class YamlList(list):
+    """A list that remembers where it and each of its items start in the file."""
+
+    mark: Mark
+    item_marks: list[Mark]
+
+    def mark_of(self, index: int) -> Mark:
+        return self.item_marks[index] if 0 <= index < len(self.item_marks) else self.mark
+
+
+def mark_of(value: Any, default: Mark | None = None) -> Mark:
+    """The start of a located YAML value (maps and lists carry one; scalars do not)."""
+    return getattr(value, "mark", None) or default or Mark(0, 0)
+
+
+class _SafeLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, plus YAML 1.2 floats: ``1e-3`` and ``1.0e9`` are numbers, not text."""
+
+
+_SafeLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"),
+)
+
+
+def _mark(node: yaml.Node) -> Mark:
+    return Mark(node.start_mark.line + 1, node.start_mark.column + 1)
+
+
+_PLAIN_TAGS = ("tag:yaml.org,2002:map", "tag:yaml.org,2002:seq")
+MAX_NODES = 200_000  # guards against alias bombs ("billion laughs") and absurd files
+
+
+class _Budget:
+    def __init__(self, file: str) -> None:
+        self.left = MAX_NODES
+        self.file = file
+
+    def spend(self, node: yaml.Node) -> None:
+        self.left -= 1
+        if self.left < 0:
+            raise InputError([Diagnostic(self.file, *_pos(node), f"more than {MAX_NODES} YAML values "
+                                         "(an alias expanding too often?)")])
+
+
+def _construct(node: yaml.Node, loader: _SafeLoader, file: str, budget: _Budget) -> Any:
+    budget.spend(node)
+    if isinstance(node, (yaml.MappingNode, yaml.SequenceNode)) and node.tag not in _PLAIN_TAGS:
+        raise InputError([Diagnostic(file, *_pos(node), f"malformed YAML: unsupported tag {node.tag!r} "
+                                     "(files are data: only plain YAML is accepted)")])
+    if isinstance(node, yaml.MappingNode):
+        loader.flatten_mapping(node)  # resolves YAML merge keys (<<)
+        out = YamlMap()
+        out.mark, out.key_marks, out.value_marks = _mark(node), {}, {}
+        for key_node, value_node in node.value:
+            key = _construct(key_node, loader, file, budget)
+            if isinstance(key, (YamlMap, YamlList)):
+                raise InputError([Diagnostic(file, *_pos(key_node), "a mapping key must be a plain value")])
+            if key in out:
+                raise InputError([Diagnostic(file, *_pos(key_node), f"duplicate key {key!r}")])
+            out[key] = _construct(value_node, loader, file, budget)
+            out.key_marks[key] = _mark(key_node)
+            out.value_marks[key] = _mark(value_node)
+        return out
+    if isinstance(node, yaml.SequenceNode):
+        items = YamlList(_construct(child, loader, file, budget) for child in node.value)
+        items.mark, items.item_marks = _mark(node), [_mark(child) for child in node.value]
+        return items
+    return loader.construct_object(node, deep=True)
+
+
+def _pos(node: yaml.Node) -> tuple[int, int]:
+    return node.start_mark.line + 1, node.start_mark.column + 1
+
+
+def parse_yaml(text: str, *, file: str = "<string>") -> Any:
+    """Parse YAML text safely into located values; raise :class:`InputError` with the position."""
+    loader = None
+    try:
+        loader = _SafeLoader(text)
+        node = loader.get_single_node()
+        if node is None:
+            raise InputError([Diagnostic(file, 1, 1, "the file is empty")])
+        return _construct(node, loader, file, _Budget(file))
+    except yaml.reader.ReaderError as exc:
+        line = text.count("\n", 0, exc.position) + 1
+        col = exc.position - (text.rfind("\n", 0, exc.position) + 1) + 1
+        raise InputError([Diagnostic(file, line, col, f"character #x{exc.character:04x} is not allowed in "
+                                     "YAML")]) from None
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line, col = (mark.line + 1, mark.column + 1) if mark else (0, 0)
+        problem = exc.problem or exc.context or "malformed YAML"
+        raise InputError([Diagnostic(file, line, col, f"malformed YAML: {problem}")]) from None
+    except yaml.YAMLError as exc:
+        raise InputError([Diagnostic(file, 0, 0, f"malformed YAML: {exc}")]) from None
+    except RecursionError:
+        raise InputError([Diagnostic(file, 0, 0, "malformed YAML: nested too deeply")]) from None
+    finally:
+        if loader is not None:
+            loader.dispose()
+
+
+def read_text(path: str | os.PathLike) -> str:
+    """Read a UTF-8 text file named by the user; clear :class:`InputError` on any failure."""
+    name = str(path)
+    try:
+        data = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise InputError([Diagnostic(name, 0, 0, "no such file")]) from None
+    except IsADirectoryError:
+        raise InputError([Diagnostic(name, 0, 0, "is a directory, not a file")]) from None
+    except OSError as exc:
+        raise InputError([Diagnostic(name, 0, 0, f"cannot read: {exc.strerror}")]) from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        col = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise InputError([Diagnostic(name, line, col, "the file is not valid UTF-8 text")]) from None
+
+
+def load_yaml(path: str | os.PathLike) -> Any:
+    """Read and safely parse a YAML file named by the user, keeping positions for diagnostics."""
+    text = read_text(path)
+    if not text.strip():
+        raise InputError([Diagnostic(str(path), 1, 1, "the file is empty")])
+    return parse_yaml(text, file=str(path))
+
+
+def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
+    """Write ``data`` so that ``path`` holds either the old content or all of the new one."""
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    try:  # make the rename itself durable
+        dir_fd = os.open(target.parent, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(dir_fd)
+    except OSError:
+        pass
+    finally:
+        os.close(dir_fd)
+
+
+def write_text_atomic(path: str | os.PathLike, text: str) -> None:
+    """Atomic UTF-8 text write (see :func:`write_bytes_atomic`)."""
+    write_bytes_atomic(path, text.encode("utf-8"))
+
+
+def write_yaml(path: str | os.PathLike, data: Any, *, header: str = "") -> None:
+    """Atomically write plain data as block-style YAML, with an optional ``# header`` comment."""
+    body = yaml.safe_dump(_plain(data), sort_keys=False, default_flow_style=None, allow_unicode=True)
+    comment = "".join(f"# {line}\n" for line in header.splitlines())
+    write_text_atomic(path, comment + body)
+
+
+def write_json(path: str | os.PathLike, data: Any) -> None:
+    """Atomically write JSON (reports), indented for people."""
+    write_text_atomic(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
+
+
+def checksum(payload: bytes) -> str:
+    """The checksum stored in versioned map files (SHA-256, hex)."""
+    return hashlib.sha256(payload).hexdigest()
+
+
+def _plain(value: Any) -> Any:
+    """Located containers and numpy scalars to plain Python for dumping."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if hasattr(value, "item") and callable(value.item):  # numpy scalar
+        return value.item()
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    return value

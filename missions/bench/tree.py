@@ -1,0 +1,96 @@
+"""Tick overhead of the runner on a 30-node tree, next to bare py_trees ticking the same tree.
+
+Figures: microseconds per tick for (a) py_trees ``tick_once`` of the task tree alone, (b) the
+runner's whole tick (sense branch, task tree, command clearing and dispatch) without the
+simulator, and (c) the same with the empty-world simulator stepped each tick; ratios b/a and c/a.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+
+import py_trees
+
+from behaviours.clock import ManualClock
+from drivers.fake import fake_robot
+from drivers.sim.simulation import Simulation
+from missions.builder import build_node
+from missions.loader import load_mission
+from missions.runner import Runner, RunOptions
+
+BRANCH = """
+      - Sequence:
+          memory: false
+          children:
+            - CheckBlackboard: {key: /robot/stalled, op: "==", value: false}
+            - Wait: {duration: 1.0e9}"""
+MISSION = "mission: bench-30\ntree:\n  Parallel:\n    policy: all\n    synchronise: false\n    children:" + (
+    BRANCH * 9) + """
+      - Drive: {distance: 1000.0, speed: 0.01}
+      - Rotate: {angle: 100000.0, speed: 1.0}
+"""
+
+
+def _mission():
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "bench.yaml"
+        path.write_text(MISSION)
+        return load_mission(path)
+
+
+def _time_runner(mission, ticks: int, *, simulate: bool) -> float:
+    if simulate:
+        simulation = Simulation.load(None, seed=0)
+        robot = simulation.robot
+    else:
+        simulation, robot = None, fake_robot()
+    options = RunOptions(max_time_s=ticks / mission.rate_hz)
+    clock = ManualClock()
+    runner = Runner(mission, robot, simulation=simulation, clock=clock, options=options)
+    if simulation is None:  # no world to step: advance the manual clock ourselves, no sleeping
+        runner._advance = lambda _started: clock.set(runner.ticks * runner.period)  # noqa: SLF001
+    start = time.perf_counter()
+    result = runner.run()
+    elapsed = time.perf_counter() - start
+    assert result.ticks == ticks, (result.ticks, result.reason)
+    return elapsed / ticks * 1e6
+
+
+def _time_bare(mission, ticks: int) -> float:
+    py_trees.blackboard.Blackboard.clear()
+    task = build_node(mission.tree)
+    clock = ManualClock()
+    for node in task.iterate():
+        node.setup(clock=clock)
+    py_trees.blackboard.Blackboard.set("/robot/stalled", False)
+    from perception.geometry import Pose2D
+
+    py_trees.blackboard.Blackboard.set("/robot/odometry", Pose2D())
+    start = time.perf_counter()
+    for i in range(ticks):
+        task.tick_once()
+        clock.set((i + 1) * 0.1)
+    return (time.perf_counter() - start) / ticks * 1e6
+
+
+def run(quick: bool = False) -> dict:
+    mission = _mission()
+    nodes = sum(1 for _ in mission.tree.walk())
+    ticks = 300 if quick else 3000
+    best = {"bare": float("inf"), "runner": float("inf"), "runner_sim": float("inf")}
+    for _ in range(1 if quick else 3):
+        best["bare"] = min(best["bare"], _time_bare(mission, ticks))
+        best["runner"] = min(best["runner"], _time_runner(mission, ticks, simulate=False))
+        best["runner_sim"] = min(best["runner_sim"], _time_runner(mission, ticks, simulate=True))
+    return {
+        "task_tree_nodes": nodes,
+        "ticks": ticks,
+        "py_trees_tick_us": round(best["bare"], 2),
+        "runner_tick_us": round(best["runner"], 2),
+        "runner_tick_with_sim_us": round(best["runner_sim"], 2),
+        "runner_overhead_ratio": round(best["runner"] / best["bare"], 3),
+        "runner_with_sim_ratio": round(best["runner_sim"] / best["bare"], 3),
+        "max_tick_rate_hz": round(1e6 / best["runner_sim"]),
+    }

@@ -1,0 +1,48 @@
+"""Turn a validated :class:`~missions.language.MissionSpec` into a py_trees tree.
+
+The root is the py_trees_ros idiom: a parallel of the data-gathering branch (driver readings,
+then the mission's own ``sense:`` nodes) and the mission's task tree. The root succeeds when the
+task succeeds and fails as soon as either branch fails.
+"""
+
+from __future__ import annotations
+
+import py_trees
+from py_trees.common import ParallelPolicy
+
+from behaviours.registry import lookup
+from behaviours.sense import GrabFrames, ReadOdometry, ReadPanTilt
+from missions.language import MissionSpec, NodeSpec
+
+ROOT_NAME = "bearings"
+SENSE_NAME = "sense"
+
+
+def build_node(spec: NodeSpec) -> py_trees.behaviour.Behaviour:
+    """The py_trees behaviour (with its subtree) for one validated node."""
+    node_type = lookup(spec.type)
+    if node_type is None:  # the loader checked this; a spec built by hand may not have been
+        raise ValueError(f"unknown node type {spec.type!r}")
+    children = [build_node(child) for child in spec.children]
+    if node_type.kind == "composite":
+        return node_type.factory(name=spec.name, children=children, **spec.params)
+    if node_type.kind == "decorator":
+        return node_type.factory(name=spec.name, child=children[0], **spec.params)
+    return node_type.factory(name=spec.name, **spec.params)
+
+
+def build_sense(mission: MissionSpec) -> py_trees.behaviour.Behaviour:
+    """The data-gathering branch: odometry, pan-tilt, cameras, then the mission's ``sense:``."""
+    nodes = [ReadOdometry(), ReadPanTilt(), GrabFrames(), *(build_node(s) for s in mission.sense)]
+    return py_trees.composites.Sequence(name=SENSE_NAME, memory=False, children=nodes)
+
+
+def build_root(mission: MissionSpec) -> tuple[py_trees.behaviour.Behaviour, py_trees.behaviour.Behaviour]:
+    """(root, task): the root parallel of sense and task, and the mission's task tree."""
+    task = build_node(mission.tree)
+    root = py_trees.composites.Parallel(
+        name=ROOT_NAME,
+        policy=ParallelPolicy.SuccessOnSelected(children=[task], synchronise=False),
+        children=[build_sense(mission), task],
+    )
+    return root, task

@@ -1,0 +1,33 @@
+"""``bearings validate``: check mission files without running them."""
+
+from __future__ import annotations
+
+import argparse
+
+from maps.store import InputError
+from missions.commands.common import EXIT_INVALID, EXIT_OK, add_mission_options, load_from_args, print_input_error
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    parser = sub.add_parser(
+        "validate", help="check mission files (syntax, node types, parameters, includes)",
+        description="Load and check each mission as 'run' would, without running it. Every problem of every "
+                    "file is reported as file:line:col: message. Exit 0 when all are valid, 2 otherwise.",
+    )
+    parser.add_argument("missions", nargs="+", metavar="MISSION", help="mission files (or shipped mission names)")
+    add_mission_options(parser)
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    status = EXIT_OK
+    for path in args.missions:
+        try:
+            mission = load_from_args(path, args)
+        except InputError as exc:
+            print_input_error(exc)
+            status = EXIT_INVALID
+            continue
+        nodes = sum(1 for _ in mission.tree.walk())
+        print(f"{mission.file}: ok ({mission.name}, {nodes} nodes, {len(mission.files) - 1} included files)")
+    return status

@@ -1,0 +1,148 @@
+"""Views of a mission tree: a unicode outline, Graphviz dot, and BehaviorTree.CPP v4 XML.
+
+The XML (``<root BTCPP_format="4">``) carries a ``TreeNodesModel`` with every bearings node
+type's ports, so Groot2 can open and display the tree. Composites map onto their BT.CPP
+counterparts (``Sequence``/``ReactiveSequence``, ``Fallback``/``ReactiveFallback``, ...).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from typing import Any
+
+from behaviours.ports import Ref
+from behaviours.registry import lookup
+from missions.language import MissionSpec, NodeSpec
+
+KIND_GLYPH = {"composite": "", "decorator": "", "action": "--> ", "condition": "--? "}
+BTCPP_MODEL_TAG = {"action": "Action", "condition": "Condition", "decorator": "Decorator", "composite": "Control"}
+
+
+def format_value(value: Any) -> str:
+    if isinstance(value, Ref):
+        return str(value)
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list):
+        return "[" + ", ".join(format_value(v) for v in value) + "]"
+    return str(value)
+
+
+def _label(node: NodeSpec) -> str:
+    node_type = lookup(node.type)
+    params = ", ".join(f"{k}={format_value(v)}" for k, v in node.params.items())
+    title = node.type if node.name == node.type else f"{node.name} ({node.type})"
+    suffix = f"  [{params}]" if params else ""
+    origin = f"  <- {node.included_from}" if node.included_from else ""
+    glyph = KIND_GLYPH.get(node_type.kind if node_type else "action", "")
+    return f"{glyph}{title}{suffix}{origin}"
+
+
+def unicode_tree(mission: MissionSpec) -> str:
+    """An indented outline with box-drawing characters, parameters and include origins."""
+    lines = [f"{mission.name}: {mission.file}"]
+    if mission.sense:
+        lines.append("├── sense (added to the data-gathering branch)")
+        for i, node in enumerate(mission.sense):
+            _outline(node, "│   ", i == len(mission.sense) - 1, lines)
+    _outline(mission.tree, "", True, lines)
+    return "\n".join(lines) + "\n"
+
+
+def _outline(node: NodeSpec, prefix: str, last: bool, lines: list[str]) -> None:
+    lines.append(f"{prefix}{'└── ' if last else '├── '}{_label(node)}")
+    inner = prefix + ("    " if last else "│   ")
+    for i, child in enumerate(node.children):
+        _outline(child, inner, i == len(node.children) - 1, lines)
+
+
+def dot_tree(mission: MissionSpec) -> str:
+    """Graphviz dot text (render with ``dot -Tsvg``)."""
+    out = [f'digraph "{_esc(mission.name)}" {{', "  graph [fontname=\"sans\"];",
+           "  node [fontname=\"sans\", fontsize=11];"]
+    shapes = {"composite": "box", "decorator": "ellipse", "action": "box", "condition": "ellipse"}
+    colours = {"composite": "#c6d9f1", "decorator": "#e8d8f0", "action": "#d9f1c6", "condition": "#f9f0c0"}
+    counter = 0
+
+    def visit(node: NodeSpec) -> str:
+        nonlocal counter
+        counter += 1
+        ident = f"n{counter}"
+        node_type = lookup(node.type)
+        kind = node_type.kind if node_type else "action"
+        label = _label(node).removeprefix(KIND_GLYPH.get(kind, ""))
+        out.append(f'  {ident} [label="{_esc(label)}", shape={shapes[kind]}, style=filled, '
+                   f'fillcolor="{colours[kind]}"];')
+        for child in node.children:
+            out.append(f"  {ident} -> {visit(child)};")
+        return ident
+
+    visit(mission.tree)
+    out.append("}")
+    return "\n".join(out) + "\n"
+
+
+def btcpp_xml(mission: MissionSpec) -> str:
+    """BehaviorTree.CPP v4 XML with a TreeNodesModel, for Groot2."""
+    root = ET.Element("root", {"BTCPP_format": "4", "main_tree_to_execute": _ident(mission.name)})
+    tree = ET.SubElement(root, "BehaviorTree", {"ID": _ident(mission.name)})
+    used: dict[str, Any] = {}
+    tree.append(_xml_node(mission.tree, used))
+    model = ET.SubElement(root, "TreeNodesModel")
+    builtin = {"Sequence", "ReactiveSequence", "Fallback", "ReactiveFallback", "Parallel", "Inverter",
+               "ForceSuccess", "ForceFailure", "RetryUntilSuccessful", "Repeat", "Timeout", "RunOnce",
+               "AlwaysSuccess", "AlwaysFailure", "Precondition"}
+    for tag, node_type in sorted(used.items()):
+        if tag in builtin:
+            continue
+        element = ET.SubElement(model, BTCPP_MODEL_TAG[node_type.kind], {"ID": tag})
+        for param in node_type.params:
+            attrs = {"name": param.name, "type": param.type}
+            if not param.required:
+                attrs["default"] = format_value(param.default)
+            port = ET.SubElement(element, "input_port", attrs)
+            port.text = param.doc + (f" [{param.unit}]" if param.unit else "")
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _xml_node(node: NodeSpec, used: dict[str, Any]) -> ET.Element:
+    node_type = lookup(node.type)
+    tag = node_type.btcpp or node.type
+    attrs: dict[str, str] = {}
+    params = dict(node.params)
+    if node.type in ("Sequence", "Selector"):
+        if not params.pop("memory", True):
+            tag = "Reactive" + tag
+    elif node.type == "Timeout":
+        attrs["msec"] = str(round(params.pop("duration") * 1000))
+    elif node.type == "Parallel":
+        policy, _ = params.pop("policy"), params.pop("synchronise")
+        count = len(node.children) if policy == "all" else 1
+        attrs.update(success_count=str(count), failure_count="1")
+    elif node.type == "OneShot":
+        attrs["then_skip"] = "true"
+        params.pop("policy")
+    elif node.type == "Guard":
+        key, op, value = params.pop("key"), params.pop("op"), params.pop("value")
+        attrs["if"] = f"{{{key}}} {op} {format_value(value)}"
+        attrs["else"] = "FAILURE"
+    for key, value in params.items():
+        attrs[key] = format_value(value)
+    if node.name != node.type:
+        attrs = {"name": node.name, **attrs}
+    used[tag] = node_type
+    element = ET.Element(tag, attrs)
+    for child in node.children:
+        element.append(_xml_node(child, used))
+    return element
+
+
+def _ident(text: str) -> str:
+    return "".join(c if c.isalnum() or c == "_" else "_" for c in text) or "MainTree"
+
+
+def _esc(text: str) -> str:
+    return text.replace("\\", "\\\\").replace('"', '\\"')

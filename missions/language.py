@@ -1,0 +1,73 @@
+"""The values a validated mission is made of: the specification the builder turns into a tree.
+
+The YAML syntax (see docs/missions.md)::
+
+    mission: square                     # name (default: the file name)
+    description: Drive a 1 m square.
+    inputs:                             # substituted at load time as ${side}; --set side=2
+      side: {type: float, default: 1.0, unit: m, description: length of a side}
+    plugins: [my_robot.behaviours]      # modules to import, explicitly
+    rate: 10                            # tick rate in Hz
+    tree:                               # one node: TypeName: {parameters}
+      Sequence:
+        children:
+          - Drive: {distance: "${side}"}
+          - Rotate: {angle: 90}
+          - include: turn_back.yaml     # a subtree from another mission file
+            inputs: {speed: 0.2}
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from behaviours.ports import Param
+
+
+@dataclass(frozen=True)
+class Location:
+    """Where something was written: file and 1-based line/column."""
+
+    file: str
+    line: int = 0
+    col: int = 0
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.col}" if self.line else self.file
+
+
+@dataclass(frozen=True)
+class NodeSpec:
+    """One validated node: its registered type, name, bound parameters and children."""
+
+    type: str
+    name: str
+    params: dict[str, Any]
+    children: tuple[NodeSpec, ...] = ()
+    location: Location = Location("<unknown>")
+    included_from: str | None = None  # the include file this node's subtree came from
+
+    def walk(self):
+        """This node and all nodes below it, depth first."""
+        yield self
+        for child in self.children:
+            yield from child.walk()
+
+
+@dataclass(frozen=True)
+class MissionSpec:
+    """A loaded, validated mission, with its inputs already substituted."""
+
+    name: str
+    file: str
+    tree: NodeSpec
+    description: str = ""
+    inputs: dict[str, Param] = field(default_factory=dict)
+    values: dict[str, Any] = field(default_factory=dict)
+    sense: tuple[NodeSpec, ...] = ()
+    plugins: tuple[str, ...] = ()
+    rate_hz: float = 10.0
+    max_time_s: float | None = None
+    evaluation: dict[str, Any] = field(default_factory=dict)
+    files: tuple[str, ...] = ()  # this file and every file it includes

@@ -1,0 +1,74 @@
+"""Record a run to a rerun file (``--save F.rrd``): robot pose, command, behaviour statuses.
+
+Uses rerun's global recording (``rr.init`` + ``rr.save``), which writes to the file with no
+viewer, so it works headless; open the file later with ``rerun F.rrd``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import py_trees
+from py_trees.common import Status
+
+STATUS_CODE = {Status.INVALID: 0, Status.RUNNING: 1, Status.SUCCESS: 2, Status.FAILURE: 3}
+
+
+class Recorder:
+    """Logs one entry per tick on the ``sim_time`` (or ``wall_time``) timeline."""
+
+    def __init__(self, path: str | Path, *, mission: str, recording_id: str, timeline: str) -> None:
+        import rerun as rr  # imported here: the viewer wheel is large and only needed with --save
+
+        self.rr = rr
+        self.timeline = timeline
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        rr.init("bearings", recording_id=recording_id, spawn=False)
+        rr.save(str(self.path))
+        self._last_status: dict[str, Status] = {}
+        rr.log("tree/status_legend", rr.TextDocument("0 invalid, 1 running, 2 success, 3 failure"), static=True)
+
+    def log_tick(self, *, time_s: float, tick: int, root: py_trees.behaviour.Behaviour, odometry: Any,
+                 command: Any, simulation: Any = None) -> None:
+        rr = self.rr
+        rr.set_time(self.timeline, duration=time_s)
+        rr.set_time("tick", sequence=tick)
+        if odometry is not None:
+            rr.log("world/robot/odometry", rr.Points2D([[odometry.x, odometry.y]], radii=0.04))
+            rr.log("robot/odometry/theta", rr.Scalars([odometry.theta]))
+        if command is not None:
+            rr.log("robot/command/v", rr.Scalars([command.v]))
+            rr.log("robot/command/w", rr.Scalars([command.w]))
+        for path, node in _paths(root):
+            rr.log(f"tree/{path}", rr.Scalars([STATUS_CODE[node.status]]))
+            if self._last_status.get(path) != node.status:
+                self._last_status[path] = node.status
+                message = f"{path}: {node.status.value}" + (f" ({node.feedback_message})"
+                                                             if node.feedback_message else "")
+                rr.log("tree/events", rr.TextLog(message))
+        if simulation is not None:
+            simulation.log_rerun(rr)
+
+    def close(self) -> None:
+        self.rr.disconnect()
+
+
+def _paths(root: py_trees.behaviour.Behaviour, prefix: str = ""):
+    """(entity path, node) for every node, the path made of sanitised, de-duplicated names."""
+    seen: dict[str, int] = {}
+    for child in [root]:
+        yield from _walk(child, prefix, seen)
+
+
+def _walk(node: py_trees.behaviour.Behaviour, prefix: str, seen: dict[str, int]):
+    name = "".join(c if c.isalnum() or c in "-_" else "_" for c in node.name) or "node"
+    path = f"{prefix}/{name}" if prefix else name
+    count = seen.get(path, 0)
+    seen[path] = count + 1
+    if count:
+        path = f"{path}_{count}"
+    yield path, node
+    for child in node.children:
+        yield from _walk(child, path, seen)

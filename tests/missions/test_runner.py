@@ -1,0 +1,202 @@
+"""The runner: whole missions in the simulator, reports, recordings, and the safety rules."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import textwrap
+
+import pytest
+
+from drivers.fake import fake_robot
+from drivers.sim.simulation import Simulation
+from missions.cli import main
+from missions.loader import load_mission
+from missions.runner import Runner, RunOptions
+
+BOOM_PLUGIN = """
+from py_trees.common import Status
+from behaviours.base import BearingsBehaviour
+from behaviours.registry import register
+
+@register
+class Boom(BearingsBehaviour):
+    '''Raises on its third tick (a test plugin).'''
+    def initialise(self):
+        self.count = 0
+    def update(self):
+        self.count += 1
+        if self.count == 3:
+            raise ZeroDivisionError("the flux capacitor")
+        return Status.RUNNING
+"""
+
+
+def test_square_mission_report_shows_the_square(tmp_path):
+    report, recording = tmp_path / "square.json", tmp_path / "square.rrd"
+    code = main(["run", "square", "--seed", "3", "--quiet", "--report", str(report), "--save", str(recording)])
+    assert code == 0
+    data = json.loads(report.read_text())
+    assert data["mission"] == "square" and data["status"] == "SUCCESS"
+    assert data["ticks"] > 100 and data["sim_time_s"] == pytest.approx(data["ticks"] / 10 - 0.1, abs=0.11)
+    gt = data["ground_truth"]
+    assert gt["trajectory_length_m"] == pytest.approx(4.0, abs=0.1)
+    assert gt["path_error_m"] < 0.05
+    assert gt["goal_error_m"] < 0.2
+    xy = [(row[1], row[2]) for row in gt["trajectory"]]
+    corners = [(1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+    for cx, cy in corners:  # the true path passes near every corner of the square
+        assert min(math.hypot(x - cx, y - cy) for x, y in xy) < 0.12
+    assert recording.stat().st_size > 10_000
+
+
+def test_same_seed_same_report_different_seed_different_run(tmp_path):
+    def run(seed: int) -> dict:
+        path = tmp_path / f"r{seed}.json"
+        assert main(["run", "square", "--seed", str(seed), "--quiet", "--report", str(path)]) == 0
+        data = json.loads(path.read_text())
+        data.pop("wall_time_s")
+        return data
+
+    first, again, other = run(7), run(7), run(8)
+    assert first == again
+    assert first["ground_truth"]["trajectory"] != other["ground_truth"]["trajectory"]
+
+
+def _mission(write_mission, tree: str, **extra: str):
+    head = "".join(f"{k}: {v}\n" for k, v in extra.items())
+    return load_mission(write_mission(head + "tree:\n" + textwrap.indent(textwrap.dedent(tree), "  ")))
+
+
+def test_exception_in_a_behaviour_is_a_failure_with_a_reason_and_a_stop(write_mission, tmp_path):
+    (tmp_path / "boom.py").write_text(BOOM_PLUGIN)
+    mission = _mission(write_mission, """
+        Parallel:
+          children:
+            - Drive: {distance: 10.0}
+            - Boom
+    """, plugins="[./boom.py]")
+    robot = fake_robot()
+    result = Runner(mission, robot, options=RunOptions(report_path=tmp_path / "r.json"),
+                    simulation=_NoWorld()).run()
+    assert result.status == "FAILURE"
+    assert result.reason == "Boom (Boom) raised ZeroDivisionError: the flux capacitor"
+    assert any(v > 0 for v, _ in robot.base.commands)  # it was driving ...
+    assert robot.base.commands[-1] == (0.0, 0.0)  # ... and the last command is a stop
+    assert robot.base.closed is False  # closing is the caller's job, after the stop
+    assert json.loads((tmp_path / "r.json").read_text())["reason"] == result.reason
+
+
+def test_failure_of_the_tree_stops_the_robot(write_mission):
+    mission = _mission(write_mission, """
+        Sequence:
+          children:
+            - Timeout:
+                duration: 1.0
+                child: {Drive: {distance: 10.0}}
+    """)
+    robot = fake_robot()
+    result = Runner(mission, robot, simulation=_NoWorld()).run()
+    assert result.status == "FAILURE" and result.ticks == 11
+    assert "timed out after 1 s" in result.reason
+    assert robot.base.commands[-1] == (0.0, 0.0)
+
+
+def test_sigterm_stops_the_robot_and_reports(write_mission, tmp_path):
+    mission = _mission(write_mission, "Drive: {distance: 100.0}\n")
+    robot = fake_robot()
+
+    def terminate_at_tick_5(runner: Runner) -> None:
+        if runner.ticks == 5:
+            os.kill(os.getpid(), signal.SIGTERM)
+
+    previous = signal.getsignal(signal.SIGTERM)
+    result = Runner(mission, robot, simulation=_NoWorld(), on_tick=terminate_at_tick_5,
+                    options=RunOptions(report_path=tmp_path / "r.json")).run()
+    assert result.status == "FAILURE" and result.reason == "interrupted by SIGTERM"
+    assert result.ticks == 5
+    assert robot.base.commands[-1] == (0.0, 0.0)
+    assert signal.getsignal(signal.SIGTERM) is previous  # handlers restored
+    assert json.loads((tmp_path / "r.json").read_text())["status"] == "FAILURE"
+
+
+def test_a_dead_sensor_fails_the_mission_and_stops(write_mission):
+    mission = _mission(write_mission, "Drive: {distance: 1.0}\n")
+    robot = fake_robot()
+    robot.base.fail_on_odometry = OSError("serial port vanished")
+    result = Runner(mission, robot, simulation=_NoWorld()).run()
+    assert result.reason == "ReadOdometry (ReadOdometry) raised OSError: serial port vanished"
+    assert robot.base.commands == [(0.0, 0.0)]
+
+
+def test_max_time_is_a_failure(write_mission):
+    mission = _mission(write_mission, "Wait: {duration: 100.0}\n")
+    result = Runner(mission, fake_robot(), simulation=_NoWorld(), options=RunOptions(max_time_s=2.0)).run()
+    assert result.status == "FAILURE" and result.reason == "time limit of 2 s reached"
+    assert result.ticks == 20
+
+
+def test_commands_do_not_outlive_their_tick(write_mission):
+    mission = _mission(write_mission, """
+        Sequence:
+          children:
+            - Drive: {distance: 0.02, speed: 0.2}
+            - Wait: {duration: 0.5}
+    """)
+    sim = Simulation.load(None, seed=0)
+    Runner(mission, sim.robot, simulation=sim).run()
+    commands = sim.robot.base.commands
+    moving = [i for i, (_, v, _w) in enumerate(commands) if v != 0.0]
+    assert moving and all(v == 0.0 for _, v, _w in commands[moving[-1] + 1:])
+    assert len(commands) - moving[-1] > 4  # the waiting ticks sent stops, not the old command
+
+
+def test_cli_exit_codes(write_mission, capsys):
+    good = write_mission("tree: Stop\n", name="good.yaml")
+    bad = write_mission("tree: Stpo\n", name="bad.yaml")
+    failing = write_mission("tree: Failure\n", name="failing.yaml")
+    assert main(["run", str(good), "--quiet"]) == 0
+    assert main(["run", str(failing), "--quiet"]) == 1
+    assert main(["run", str(bad), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}:1:7: unknown node type 'Stpo'; did you mean 'Stop'?" in err
+    assert "Traceback" not in err
+    assert main(["run", str(good), "--sim", "no-such-world", "--quiet"]) == 2
+    assert main(["run", str(good), "--set", "novalue", "--quiet"]) == 2
+    assert main(["validate", str(good), str(bad)]) == 2
+    assert main(["validate", str(good)]) == 0
+
+
+def test_show_formats(capsys):
+    import xml.etree.ElementTree as ET
+
+    assert main(["show", "square", "--format", "xml"]) == 0
+    root = ET.fromstring(capsys.readouterr().out.split("\n", 1)[1])
+    assert root.tag == "root" and root.get("BTCPP_format") == "4"
+    assert root.find("BehaviorTree/Sequence/Repeat").get("num_cycles") == "4"
+    assert root.find("TreeNodesModel/Action[@ID='Drive']/input_port[@name='distance']") is not None
+    assert main(["show", "square", "--format", "dot"]) == 0
+    assert capsys.readouterr().out.startswith('digraph "square"')
+    assert main(["show", "square"]) == 0
+    assert "└── --> Stop" in capsys.readouterr().out
+
+
+def test_reactive_composites_export_as_reactive(write_mission, capsys):
+    path = write_mission("tree:\n  Selector:\n    memory: false\n    children: [Stop, Failure]\n")
+    assert main(["show", str(path), "--format", "xml"]) == 0
+    assert "<ReactiveFallback>" in capsys.readouterr().out
+
+
+class _NoWorld:
+    """A stand-in simulation with no world: only time passes (for runs on fake drivers)."""
+
+    def step(self, dt: float) -> None:
+        pass
+
+    def ground_truth_report(self, **_kwargs) -> dict:
+        return {}
+
+    def log_rerun(self, rr) -> None:
+        pass
