@@ -27,6 +27,18 @@ class _ClockedDecorator(py_trees.decorators.Decorator):
     def setup(self, **kwargs: Any) -> None:
         self._clock = kwargs.get("clock", self._clock)
 
+    def _tick_child(self) -> Iterator[py_trees.behaviour.Behaviour]:
+        """Tick the child and take its status (what these decorators do once they let it run)."""
+        yield from self.decorated.tick()
+        new_status = self.decorated.status
+        if new_status != Status.RUNNING:
+            self.stop(new_status)
+        self.status = new_status
+        yield self
+
+    def update(self) -> Status:
+        return self.decorated.status
+
     def now(self) -> float:
         if self._clock is None:
             raise NotSetUp(f"{self.name}: no clock; set the tree up with setup(clock=...)")
@@ -57,15 +69,7 @@ class Timeout(_ClockedDecorator):
             self.stop(Status.FAILURE)
             yield self
             return
-        yield from self.decorated.tick()
-        new_status = self.decorated.status
-        if new_status != Status.RUNNING:
-            self.stop(new_status)
-        self.status = new_status
-        yield self
-
-    def update(self) -> Status:
-        return self.decorated.status
+        yield from self._tick_child()
 
 
 class RateController(_ClockedDecorator):
@@ -89,15 +93,7 @@ class RateController(_ClockedDecorator):
             yield self
             return
         self._last_tick = now
-        yield from self.decorated.tick()
-        new_status = self.decorated.status
-        if new_status != Status.RUNNING:
-            self.stop(new_status)
-        self.status = new_status
-        yield self
-
-    def update(self) -> Status:
-        return self.decorated.status
+        yield from self._tick_child()
 
 
 def make_guard(name: str, child: py_trees.behaviour.Behaviour, key: str, op: str, value: Any):

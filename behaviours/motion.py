@@ -48,6 +48,19 @@ class _OdometryMotion(BearingsBehaviour):
             return True
         return False
 
+    def update(self) -> Status:
+        pose = self.odometry()
+        if pose is None:
+            self.feedback_message = "waiting for odometry"
+            return Status.RUNNING
+        if self.blocked():
+            return Status.FAILURE
+        return self.step(pose)
+
+    def step(self, pose: Pose2D) -> Status:
+        """One control step from the current odometry (the base is known not to be stalled)."""
+        raise NotImplementedError
+
     def terminate(self, new_status: Status) -> None:
         if new_status != Status.RUNNING:
             self.write("/robot/command", STOP)
@@ -66,15 +79,9 @@ class Drive(_OdometryMotion):
     def initialise(self) -> None:
         self._start: Pose2D | None = self.odometry()
 
-    def update(self) -> Status:
-        pose = self.odometry()
-        if pose is None:
-            self.feedback_message = "waiting for odometry"
-            return Status.RUNNING
+    def step(self, pose: Pose2D) -> Status:
         if self._start is None:
             self._start = pose
-        if self.blocked():
-            return Status.FAILURE
         start = self._start
         travelled = (pose.x - start.x) * math.cos(start.theta) + (pose.y - start.y) * math.sin(start.theta)
         remaining = float(self.param("distance")) - travelled
@@ -102,13 +109,7 @@ class Rotate(_OdometryMotion):
         self._last: float | None = None
         self._turned = 0.0
 
-    def update(self) -> Status:
-        pose = self.odometry()
-        if pose is None:
-            self.feedback_message = "waiting for odometry"
-            return Status.RUNNING
-        if self.blocked():
-            return Status.FAILURE
+    def step(self, pose: Pose2D) -> Status:
         if self._last is not None:
             self._turned += wrap_angle(pose.theta - self._last)  # unwrapped: angles beyond 180 deg work
         self._last = pose.theta
@@ -134,13 +135,7 @@ class DriveTo(_OdometryMotion):
     )
     TURN_IN_PLACE = math.radians(30.0)  # heading error above which the robot turns before driving
 
-    def update(self) -> Status:
-        pose = self.odometry()
-        if pose is None:
-            self.feedback_message = "waiting for odometry"
-            return Status.RUNNING
-        if self.blocked():
-            return Status.FAILURE
+    def step(self, pose: Pose2D) -> Status:
         dx, dy = float(self.param("x")) - pose.x, float(self.param("y")) - pose.y
         distance = math.hypot(dx, dy)
         if distance <= float(self.param("tolerance")):
@@ -157,7 +152,7 @@ class DriveTo(_OdometryMotion):
 
 @register
 class Stop(_OdometryMotion):
-    """Command the base to rest; SUCCESS at once."""
+    """Command the base to rest; SUCCESS at once (with or without odometry, stalled or not)."""
 
     def update(self) -> Status:
         self.command(0.0, 0.0)

@@ -93,19 +93,19 @@ def check_value(param: Param, value: Any) -> tuple[Any, str | None]:
         return value, None
     if kind == "float":
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            return value, f"expects a number{_unit(param)}, got {_show(value)}"
+            return value, f"expects a number{_unit(param)}, got {describe_value(value)}"
         value = float(value)
         if not math.isfinite(value):
             return value, f"expects a finite number, got {value}"
     elif kind == "int":
         if isinstance(value, bool) or not isinstance(value, int):
-            return value, f"expects a whole number, got {_show(value)}"
+            return value, f"expects a whole number, got {describe_value(value)}"
     elif kind == "bool":
         if not isinstance(value, bool):
-            return value, f"expects true or false, got {_show(value)}"
+            return value, f"expects true or false, got {describe_value(value)}"
     elif kind in ("str", "key"):
         if not isinstance(value, str):
-            return value, f"expects text, got {_show(value)}"
+            return value, f"expects text, got {describe_value(value)}"
         if kind == "key":
             if key_spec(value) is None:
                 return value, f"unknown blackboard key {value!r}"
@@ -113,11 +113,11 @@ def check_value(param: Param, value: Any) -> tuple[Any, str | None]:
             return value, f"expects one of {', '.join(param.choices)}, got {value!r}"
     elif kind == "list[float]":
         if not isinstance(value, Sequence) or isinstance(value, str):
-            return value, f"expects a list of numbers, got {_show(value)}"
+            return value, f"expects a list of numbers, got {describe_value(value)}"
         items = []
         for item in value:
             if isinstance(item, bool) or not isinstance(item, (int, float)):
-                return value, f"expects a list of numbers, found {_show(item)}"
+                return value, f"expects a list of numbers, found {describe_value(item)}"
             items.append(float(item))
         value = items
     if kind in ("float", "int"):
@@ -148,7 +148,8 @@ def _unit(param: Param) -> str:
     return f" in {param.unit}" if param.unit else ""
 
 
-def _show(value: Any) -> str:
+def describe_value(value: Any) -> str:
+    """A value as error messages name it: 'a mapping', 'a list', 'nothing (null)' or its repr."""
     if isinstance(value, dict):
         return "a mapping"
     if isinstance(value, list):

@@ -25,7 +25,7 @@ import yaml
 
 import behaviours  # noqa: F401  (registers the built-in node types)
 from behaviours.keys import key_spec
-from behaviours.ports import REQUIRED, TYPES, Param, check_ref, check_value, parse_ref
+from behaviours.ports import REQUIRED, TYPES, Param, check_ref, check_value, describe_value, parse_ref
 from behaviours.registry import NodeType, all_types, lookup
 from maps.store import Diagnostic, InputError, Mark, YamlList, YamlMap, load_yaml, mark_of
 from missions.language import Location, MissionSpec, NodeSpec
@@ -199,7 +199,7 @@ class _Loader:
             ((type_name, body),) = raw.items()
             mark, body_mark = raw.mark_of(type_name), raw.value_mark_of(type_name)
         else:
-            self.error(file, mark, f"expected a node like 'Drive: {{distance: 1.0}}', found {_show(raw)}")
+            self.error(file, mark, f"expected a node like 'Drive: {{distance: 1.0}}', found {describe_value(raw)}")
             return None
         node_type = lookup(type_name) if isinstance(type_name, str) else None
         if node_type is None:
@@ -210,7 +210,8 @@ class _Loader:
             body = YamlMap()
             body.mark, body.key_marks, body.value_marks = body_mark, {}, {}
         if not isinstance(body, YamlMap):
-            self.error(file, body_mark, f"{type_name}: parameters are a mapping 'name: value', found {_show(body)}")
+            self.error(file, body_mark,
+                       f"{type_name}: parameters are a mapping 'name: value', found {describe_value(body)}")
             return None
         name = body.get("name", type_name)
         if not isinstance(name, str) or not name.strip():
@@ -577,13 +578,3 @@ def _suggest(word: Any, options: Iterable[Any]) -> str:
     options = [str(o) for o in options]
     close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
     return f"; did you mean {close[0]!r}?" if close else ""
-
-
-def _show(value: Any) -> str:
-    if isinstance(value, dict):
-        return "a mapping"
-    if isinstance(value, list):
-        return "a list"
-    if value is None:
-        return "nothing"
-    return repr(value)
