@@ -10,7 +10,7 @@ from __future__ import annotations
 import py_trees
 from py_trees.common import OneShotPolicy, ParallelPolicy
 
-from behaviours import conditions, motion, sense, wait  # noqa: F401  (register leaf behaviours)
+from behaviours import conditions, motion, perceive, sense, wait  # noqa: F401  (register leaf behaviours)
 from behaviours.composites import RecoveryNode
 from behaviours.decorators import RateController, Timeout, make_guard
 from behaviours.ports import COMPARISONS, Param

@@ -14,6 +14,7 @@ from typing import Any, Literal
 from drivers.interfaces import PanTiltCommand, PanTiltState, VelocityCommand
 from perception.frame import Frame
 from perception.geometry import Pose2D
+from perception.observation import Observation
 
 Writer = Literal["sense", "task", "any"]
 NAMESPACES = ("/robot", "/ptu", "/perception", "/map", "/mission")
@@ -66,7 +67,7 @@ for _spec in (
     KeySpec("/ptu/command", PanTiltCommand, "task", "pan/tilt target; cleared before every tick"),
     KeySpec("/perception/frames", dict, "sense", "latest Frame of each camera, by camera name"),
     KeySpec("/perception/frame", Frame, "sense", "latest Frame of the primary camera"),
-    KeySpec("/perception/observation", object, "sense", "features and unit bearings of the latest frame"),
+    KeySpec("/perception/observation", Observation, "sense", "features and unit bearings of the latest frame"),
     KeySpec("/perception/motion", object, "sense", "latest Z-infinity motion estimate"),
     KeySpec("/perception/heading", float, "sense", "filtered heading correction (rad)"),
     KeySpec("/map/goal", Pose2D, "task", "the current goal pose in the odometry frame"),

@@ -57,13 +57,24 @@ class ReadPanTilt(_Sensor):
 class GrabFrames(_Sensor):
     """Grab one frame per camera into ``/perception/frames``; the first camera's also into ``frame``.
 
-    A dropped frame keeps the previous one (its stamp tells how old it is).
+    ``cameras`` limits grabbing to the named cameras (a mission's ``cameras:``), so unused
+    cameras cost neither bandwidth nor, in the simulator, rendering. A dropped frame keeps the
+    previous one (its stamp tells how old it is).
     """
 
     WRITES = ("/perception/frames", "/perception/frame")
 
+    def __init__(self, name: str | None = None, *, cameras: tuple[str, ...] | None = None) -> None:
+        super().__init__(name=name)
+        self.only = cameras
+
     def update(self) -> Status:
         cameras = self.robot.cameras
+        if self.only is not None:
+            missing = [c for c in self.only if c not in cameras]
+            if missing:
+                raise KeyError(f"the robot has no camera {', '.join(missing)} (it has: {', '.join(cameras) or 'none'})")
+            cameras = {name: cameras[name] for name in self.only}
         if not cameras:
             return Status.SUCCESS
         frames = dict(self.read("/perception/frames") or {})

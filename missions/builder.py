@@ -33,7 +33,8 @@ def build_node(spec: NodeSpec) -> py_trees.behaviour.Behaviour:
 
 def build_sense(mission: MissionSpec) -> py_trees.behaviour.Behaviour:
     """The data-gathering branch: odometry, pan-tilt, cameras, then the mission's ``sense:``."""
-    nodes = [ReadOdometry(), ReadPanTilt(), GrabFrames(), *(build_node(s) for s in mission.sense)]
+    readings = [ReadOdometry(), ReadPanTilt(), GrabFrames(cameras=mission.cameras)]
+    nodes = [*readings, *(build_node(s) for s in mission.sense)]
     return py_trees.composites.Sequence(name=SENSE_NAME, memory=False, children=nodes)
 
 

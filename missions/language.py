@@ -70,4 +70,5 @@ class MissionSpec:
     rate_hz: float = 10.0
     max_time_s: float | None = None
     evaluation: dict[str, Any] = field(default_factory=dict)
+    cameras: tuple[str, ...] | None = None  # the cameras this mission grabs; None: every camera
     files: tuple[str, ...] = ()  # this file and every file it includes

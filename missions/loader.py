@@ -33,8 +33,8 @@ from missions.language import Location, MissionSpec, NodeSpec
 LIBRARY = Path(__file__).parent / "library"
 PATH_ENV = "BEARINGS_PATH"
 MAX_DEPTH = 100
-TOP_KEYS = ("mission", "description", "version", "inputs", "plugins", "rate", "max_time", "sense", "tree",
-            "evaluation")
+TOP_KEYS = ("mission", "description", "version", "inputs", "plugins", "rate", "max_time", "cameras", "sense",
+            "tree", "evaluation")
 INCLUDE_KEYS = ("include", "inputs", "name")
 STRUCTURE_KEYS = ("name", "children", "child")
 INPUT_KEYS = ("type", "default", "unit", "description")
@@ -341,7 +341,7 @@ class _Loader:
         doc = self.document(path)
         if doc is None:
             return None
-        if "sense" in doc:  # rate, max_time and evaluation of an included mission are simply not used
+        if "sense" in doc:  # rate, max_time, cameras and evaluation of an included mission are not used
             self.error(str(path), doc.mark_of("sense"), "'sense:' of an included mission would be lost: move "
                        "these nodes to the top-level mission's 'sense:'")
         self.import_plugins(doc, path)
@@ -407,6 +407,7 @@ def load_mission(
     rate = _number(loader, doc, "rate", file, default=10.0, low=0.1, high=1000.0, unit="Hz")
     max_time = _number(loader, doc, "max_time", file, default=None, low=0.0, high=1e7, unit="s")
     sense = _sense(loader, doc, scope)
+    cameras = _cameras(loader, doc, file)
     tree = None
     if "tree" not in doc:
         loader.error(file, doc.mark, "the mission has no 'tree:' (the root node of the mission)")
@@ -418,7 +419,7 @@ def load_mission(
     return MissionSpec(
         name=name, file=file, tree=tree, description=description, inputs=declared, values=values,
         sense=sense, plugins=tuple(loader.plugins), rate_hz=rate, max_time_s=max_time,
-        evaluation=evaluation, files=tuple(dict.fromkeys(loader.files)),
+        evaluation=evaluation, files=tuple(dict.fromkeys(loader.files)), cameras=cameras,
     )
 
 
@@ -483,6 +484,16 @@ def _sense(loader: _Loader, doc: YamlMap, scope: _Scope) -> tuple[NodeSpec, ...]
     return tuple(n for n in nodes if n is not None)
 
 
+def _cameras(loader: _Loader, doc: YamlMap, file: str) -> tuple[str, ...] | None:
+    raw = doc.get("cameras")
+    if raw is None:
+        return None
+    if not isinstance(raw, YamlList) or not all(isinstance(c, str) and c for c in raw):
+        loader.error(file, doc.value_mark_of("cameras"), "'cameras:' is a list of camera names")
+        return None
+    return tuple(raw)
+
+
 def _evaluation(loader: _Loader, doc: YamlMap, scope: _Scope) -> dict[str, Any]:
     raw = doc.get("evaluation")
     if raw is None:
@@ -503,6 +514,12 @@ def _evaluation(loader: _Loader, doc: YamlMap, scope: _Scope) -> dict[str, Any]:
                 loader.error(file, mark, "evaluation.goal is a point [x, y] in metres (world frame)")
                 continue
             out["goal"] = [float(v) for v in value]
+        elif key == "frame":
+            if value not in ("world", "start"):
+                loader.error(file, mark, "evaluation.frame is 'world' (the world's coordinates) or 'start' "
+                             "(relative to the robot's true start pose)")
+                continue
+            out["frame"] = value
         elif key == "reference_path":
             if not isinstance(value, list) or len(value) < 2 or not all(_is_point(p) for p in value):
                 loader.error(file, mark, "evaluation.reference_path is a list of at least two points [x, y]")
@@ -510,7 +527,7 @@ def _evaluation(loader: _Loader, doc: YamlMap, scope: _Scope) -> dict[str, Any]:
             out["reference_path"] = [[float(v) for v in p] for p in value]
         else:
             loader.error(file, raw.mark_of(key), f"unknown evaluation entry {key!r}"
-                         f"{_suggest(str(key), ('goal', 'reference_path'))}")
+                         f"{_suggest(str(key), ('goal', 'reference_path', 'frame'))}")
     return out
 
 

@@ -254,7 +254,8 @@ class Runner:
         if self.simulation is not None:
             report["sim_time_s"] = round(result.time_s, 6)
             report["ground_truth"] = self.simulation.ground_truth_report(
-                goal=mission.evaluation.get("goal"), reference_path=mission.evaluation.get("reference_path"))
+                goal=mission.evaluation.get("goal"), reference_path=mission.evaluation.get("reference_path"),
+                frame=mission.evaluation.get("frame", "world"))
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}

@@ -1,4 +1,4 @@
-"""One camera image with the model that turns its pixels into bearings."""
+"""What a camera delivers: an image with its model, or (ideal sensors) identified bearings."""
 
 from __future__ import annotations
 
@@ -21,3 +21,27 @@ class Frame:
     stamp: float
     camera_name: str = "camera"
     right: np.ndarray | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class LandmarkBearings:
+    """What a ``bearings`` sensor reports at ``stamp``: ``ids`` (N,) int64 and unit ``bearings``
+    (N, 3) float64 in the body frame of camera ``camera_name``, sorted by id."""
+
+    ids: np.ndarray
+    bearings: np.ndarray
+    stamp: float
+    camera_name: str = "bearings"
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    @property
+    def count(self) -> int:
+        """How many landmarks are seen (the same name as :class:`perception.observation.Observation`)."""
+        return len(self.ids)
+
+    def bearing_of(self, landmark_id: int) -> np.ndarray | None:
+        """The bearing of one landmark, or None when it is not seen."""
+        hit = np.flatnonzero(self.ids == landmark_id)
+        return self.bearings[hit[0]] if hit.size else None

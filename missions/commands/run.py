@@ -49,6 +49,13 @@ def run(args: argparse.Namespace) -> int:
         simulation, robot = _open(args)
     except InputError as exc:
         return print_input_error(exc)
+    missing = [c for c in mission.cameras or () if c not in robot.cameras]
+    if missing:
+        robot.close()
+        where = args.robot or f"world {args.sim or 'empty'}"
+        return print_input_error(InputError([Diagnostic(mission.file, 0, 0, f"the mission uses camera(s) "
+                                 f"{', '.join(missing)}, which {where} does not have (it has: "
+                                 f"{', '.join(robot.cameras) or 'none'})")]))
     options = RunOptions(
         rate_hz=args.rate, max_time_s=args.max_time, realtime=args.realtime, report_path=args.report,
         save_path=args.save, progress=not args.quiet and sys.stderr.isatty(), seed=args.seed, debug=args.debug,

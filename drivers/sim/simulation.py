@@ -1,0 +1,302 @@
+"""The simulated robot: world, base, pan-tilt and cameras stepped by the runner's clock.
+
+The runner only uses this API: :meth:`Simulation.load`, :attr:`Simulation.robot`,
+:meth:`Simulation.step`, :meth:`Simulation.ground_truth_report` and :meth:`Simulation.log_rerun`;
+perception benchmarks and ``bearings sim snapshot`` use :meth:`Simulation.snapshot`.
+Ground truth stays in here; behaviours only see the :class:`~drivers.interfaces.Robot`
+interfaces, exactly as on hardware.
+
+Determinism: every source of randomness is a numpy Generator derived from the seed (wheel slip
+from ``seed`` itself, each camera and the run's lighting from their own spawned streams, so
+adding a camera does not change the robot's motion). Same world and seed: same trajectory,
+bit-identical images and reports.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drivers.interfaces import Robot
+from drivers.sim.cameras import SimCamera, run_lighting
+from drivers.sim.kinematics import DiffDrive, DiffDriveLimits, SlipModel
+from drivers.sim.ptu import SimPanTilt
+from drivers.sim.scene import Scene
+from drivers.sim.sensors import LandmarkBearings
+from drivers.sim.visualise import RerunLogger
+from drivers.sim.world import World, empty_world, load_world
+from perception.frame import Frame
+from perception.geometry import Pose2D
+
+
+class SimBase:
+    """The :class:`~drivers.interfaces.Base` of the simulated robot."""
+
+    def __init__(self, sim: Simulation) -> None:
+        self._sim = sim
+        self.commands: list[tuple[float, float, float]] = []  # (time, v, w) as received
+
+    def drive(self, v: float, w: float) -> None:
+        self.commands.append((self._sim.time, float(v), float(w)))
+        self._sim.drive.command(v, w)
+
+    def stop(self) -> None:
+        self.drive(0.0, 0.0)
+
+    def odometry(self) -> Pose2D:
+        return self._sim.drive.odometry(self._sim.time)
+
+    def stalled(self) -> bool:
+        return self._sim.stalled
+
+    def close(self) -> None:
+        pass
+
+
+@dataclass
+class GroundTruth:
+    """True and odometry trajectories as (t, x, y, theta) rows, for evaluation only."""
+
+    true: list[tuple[float, float, float, float]] = field(default_factory=list)
+    odometry: list[tuple[float, float, float, float]] = field(default_factory=list)
+
+    def record(self, t: float, true: Pose2D, odom: Pose2D) -> None:
+        self.true.append((t, true.x, true.y, true.theta))
+        self.odometry.append((t, odom.x, odom.y, odom.theta))
+
+
+class Simulation:
+    """A deterministic simulated world for one mission run."""
+
+    def __init__(
+        self,
+        world: World | None = None,
+        *,
+        seed: int = 0,
+        start: Pose2D | None = None,
+        limits: DiffDriveLimits | None = None,
+        slip: SlipModel | None = None,
+        name: str | None = None,
+        noise: bool = True,
+    ) -> None:
+        self.world = world or empty_world()
+        self.name = name or self.world.name
+        self.seed = seed
+        self.rng = np.random.default_rng(seed)  # wheel slip
+        streams = np.random.SeedSequence([seed, 0xBEA], pool_size=4).spawn(1 + len(self.world.cameras))
+        self.scene = Scene(self.world)
+        self.time = 0.0
+        self.stalled = False
+        self.collisions = 0
+        self._in_contact = False
+        self._stalled_time = 0.0
+        self.drive = DiffDrive(start=start or self.world.start, limits=limits, slip=slip, rng=self.rng)
+        self.ptu = SimPanTilt(self.world.ptu, clock=lambda: self.time)
+        self.lighting = run_lighting(self.world.lighting, np.random.default_rng(streams[0]))
+        self.cameras: dict[str, SimCamera] = {}
+        for spec, stream in zip(self.world.cameras, streams[1:], strict=True):
+            camera = SimCamera(
+                spec, self.scene, self.world.ptu, self._camera_state, rng=np.random.default_rng(stream),
+                lighting=self.lighting,
+            )  # fmt: skip
+            camera.enabled_noise = noise
+            self.cameras[spec.name] = camera
+        self.robot = Robot(base=SimBase(self), ptu=self.ptu, cameras=dict(self.cameras), name=f"sim:{self.name}")
+        self.truth = GroundTruth()
+        self.truth.record(0.0, self.drive.true(0.0), self.drive.odometry(0.0))
+        self._rerun = RerunLogger()
+
+    @classmethod
+    def load(cls, world: str | Path | World | None = None, *, seed: int = 0, **options: Any) -> Simulation:
+        """The simulation of a shipped world (by name), a world file (by path) or a :class:`World`.
+
+        None, "" or "empty": an empty plane. Invalid files raise :class:`~maps.store.InputError`
+        with every problem located. ``options`` go to the constructor (``start``, ``limits``,
+        ``slip``, ``noise``).
+        """
+        loaded = world if isinstance(world, World) else load_world(world)
+        return cls(loaded, seed=seed, **options)
+
+    # ----------------------------------------------------------------------------------------
+    # Time
+
+    def step(self, dt: float) -> None:
+        """Advance the world by ``dt`` seconds of simulated time.
+
+        A step that would bring the robot's disc into a wall, box or pillar (closer than it was)
+        does not happen: the base stops there, its wheels and odometry included, and
+        :meth:`SimBase.stalled` is True until a command moves it away.
+        """
+        drive = self.drive
+        before_true, before_odom = drive.true_pose.copy(), drive.odom_pose.copy()
+        drive.step(dt, blocked=False)
+        radius = self.world.robot_radius
+        clearance, at_end = self._swept_clearance(before_true[:2], drive.true_pose[:2], radius)
+        # blocked: touching, and closer than before (a robot in contact may still back away)
+        if clearance < radius and clearance < self.scene.clearance(before_true[0], before_true[1]) - 1e-12:
+            drive.true_pose, drive.odom_pose = before_true, before_odom
+            drive.velocity = (0.0, 0.0)
+            if not self._in_contact:  # a new contact episode (not the same push, step after step)
+                self.collisions += 1
+            self.stalled = self._in_contact = True
+        else:
+            self.stalled = False
+            self._in_contact = self._in_contact and at_end < radius + 0.01
+        if self.stalled:
+            self._stalled_time += dt
+        self.ptu.step(dt)
+        self.time += dt
+        self.truth.record(self.time, drive.true(self.time), drive.odometry(self.time))
+
+    def _swept_clearance(self, start: np.ndarray, end: np.ndarray, radius: float) -> tuple[float, float]:
+        """The smallest clearance along a step's straight path, sampled every radius / 2 (so a long
+        step cannot jump over a thin wall), and the clearance at its end."""
+        samples = max(1, math.ceil(math.hypot(end[0] - start[0], end[1] - start[1]) / (radius / 2.0)))
+        values = [self.scene.clearance(*(start + (end - start) * (i / samples))) for i in range(1, samples + 1)]
+        return min(values), values[-1]
+
+    # ----------------------------------------------------------------------------------------
+    # Ground truth (evaluation only)
+
+    def true_pose(self) -> Pose2D:
+        """The robot's true pose (evaluation only: never hand this to a behaviour)."""
+        return self.drive.true(self.time)
+
+    def odometry_in_world(self) -> np.ndarray:
+        """Where odometry believes the robot is, as world (x, y): odometry starts at the true start."""
+        return _odom_in_world(np.asarray(self.truth.true[0]), np.asarray(self.truth.odometry[-1]))
+
+    def odometry_trajectory_in_world(self) -> np.ndarray:
+        """The whole odometry trajectory as world (x, y) rows."""
+        _, x0, y0, th0 = self.truth.true[0]
+        odom = np.asarray(self.truth.odometry)[:, 1:3]
+        c, s = math.cos(th0), math.sin(th0)
+        return np.column_stack([x0 + c * odom[:, 0] - s * odom[:, 1], y0 + s * odom[:, 0] + c * odom[:, 1]])
+
+    def ground_truth_report(
+        self,
+        *,
+        goal: Sequence[float] | None = None,
+        reference_path: Sequence[Sequence[float]] | None = None,
+        frame: str = "world",
+    ) -> dict:
+        """The ``ground_truth`` section of a run report (DESIGN.md, contracts).
+
+        Always: ``trajectory_length_m``, ``final_pose``, ``odometry_drift_m``, ``collisions``,
+        ``stalled_time_s``, ``trajectory`` (decimated) and the true ``landmarks``; with ``goal``
+        (x, y): ``goal_error_m``; with a ``reference_path`` of (x, y) points: ``path_error_m``
+        (mean distance of the trajectory to it) and ``path_error_max_m``. ``goal`` and
+        ``reference_path`` are world coordinates, or with ``frame="start"`` coordinates relative
+        to the robot's true start pose (for missions written for any world, like odometry).
+        """
+        if frame not in ("world", "start"):
+            raise ValueError(f"frame must be 'world' or 'start', got {frame!r}")
+        true = np.asarray(self.truth.true, dtype=float)
+        odom = np.asarray(self.truth.odometry, dtype=float)
+        xy = true[:, 1:3]
+        if frame == "start":  # express the trajectory in the start frame instead
+            _, x0, y0, th0 = true[0]
+            c, s = math.cos(th0), math.sin(th0)
+            rel = xy - (x0, y0)
+            xy = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])
+        report: dict = {
+            "world": self.name,
+            "seed": self.seed,
+            "sim_time_s": float(self.time),
+            "evaluation_frame": frame,
+            "trajectory_length_m": float(np.sum(np.linalg.norm(np.diff(xy, axis=0), axis=1))),
+            "final_pose": {"x": float(true[-1, 1]), "y": float(true[-1, 2]), "theta": float(true[-1, 3])},
+            "odometry_drift_m": float(np.linalg.norm(true[-1, 1:3] - _odom_in_world(true[0], odom[-1]))),
+            "collisions": int(self.collisions),
+            "stalled_time_s": float(self._stalled_time),
+            "trajectory": _decimate(true, max_points=2000),
+            "landmarks": [[int(lm.id), lm.x, lm.y, lm.z] for lm in self.world.landmarks],
+        }
+        if goal is not None:
+            report["goal_error_m"] = float(math.hypot(xy[-1, 0] - goal[0], xy[-1, 1] - goal[1]))
+        if reference_path is not None and len(reference_path) >= 2:
+            distances = path_distances(xy, np.asarray(reference_path, dtype=float)[:, :2])
+            report["path_error_m"] = float(distances.mean())
+            report["path_error_max_m"] = float(distances.max())
+        return report
+
+    # ----------------------------------------------------------------------------------------
+    # Cameras
+
+    def snapshot(
+        self, pose: Pose2D, camera: str = "panorama", *, pan: float | None = None, tilt: float | None = None
+    ) -> Frame:
+        """What image camera ``camera`` would see with the robot at the TRUE ``pose``.
+
+        A pan-tilt mounted camera uses the unit's current angles unless ``pan``/``tilt`` are given.
+        Clean: the run's lighting, no exposure noise, never dropped. Stamped with the current time.
+        """
+        cam = self._camera(camera)
+        state = self.ptu.state()
+        return cam.snapshot(
+            pose, state.pan if pan is None else pan, state.tilt if tilt is None else tilt, stamp=self.time
+        )
+
+    def observe(self, pose: Pose2D, camera: str = "landmarks") -> LandmarkBearings:
+        """Noise-free landmark bearings of a ``bearings`` sensor at the TRUE ``pose``."""
+        state = self.ptu.state()
+        return self._camera(camera).observe(pose, state.pan, state.tilt, stamp=self.time)
+
+    def _camera(self, name: str) -> SimCamera:
+        if name not in self.cameras:
+            raise KeyError(f"no camera {name!r} in world {self.name!r} (cameras: {', '.join(self.cameras)})")
+        return self.cameras[name]
+
+    def _camera_state(self) -> tuple[Pose2D, float, float, float]:
+        return self.true_pose(), self.ptu.pan, self.ptu.tilt, self.time
+
+    # ----------------------------------------------------------------------------------------
+    # Visualisation
+
+    def log_rerun(self, rec: Any, *, image_every: int | None = None) -> None:
+        """Log this tick to rerun (``rec``: the rerun module or a RecordingStream).
+
+        Once: the world from above (walls, pillars, landmarks, named poses, static). Every call:
+        the true and odometry poses, heading and pan-tilt view direction. Every 20th call: the
+        trajectories. Every ``image_every``-th call (default 10): the latest frame of each camera.
+        """
+        if image_every is not None:
+            self._rerun.image_every = max(1, int(image_every))
+        self._rerun.log(self, rec)
+
+
+def path_distances(trajectory_xy: np.ndarray, reference_xy: np.ndarray) -> np.ndarray:
+    """Distance (m) from each trajectory point to the reference polyline."""
+    a, b = reference_xy[:-1], reference_xy[1:]
+    ab = b - a
+    seg_len2 = np.maximum(np.sum(ab * ab, axis=1), 1e-12)
+    p = trajectory_xy[:, None, :]
+    t = np.clip(np.sum((p - a) * ab, axis=2) / seg_len2, 0.0, 1.0)
+    closest = a + t[..., None] * ab
+    return np.linalg.norm(p - closest, axis=2).min(axis=1)
+
+
+def path_error(trajectory_xy: np.ndarray, reference_xy: np.ndarray) -> float:
+    """Mean distance (m) from the trajectory's points to the reference polyline."""
+    return float(path_distances(trajectory_xy, reference_xy).mean())
+
+
+def _odom_in_world(true_start: np.ndarray, odom_end: np.ndarray) -> np.ndarray:
+    """Where the robot believes it is, in the world frame (odometry starts at the true start)."""
+    _, x0, y0, th0 = true_start
+    _, ox, oy, _ = odom_end
+    c, s = math.cos(th0), math.sin(th0)
+    return np.array([x0 + c * ox - s * oy, y0 + s * ox + c * oy])
+
+
+def _decimate(rows: np.ndarray, *, max_points: int) -> list[list[float]]:
+    """At most ``max_points`` rows of (t, x, y, theta), first and last kept, rounded to 0.1 mm."""
+    if len(rows) > max_points:
+        idx = np.unique(np.linspace(0, len(rows) - 1, max_points).round().astype(int))
+        rows = rows[idx]
+    return np.round(rows, 4).tolist()

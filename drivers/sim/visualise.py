@@ -1,0 +1,100 @@
+"""Logging a simulation to rerun: the world from above, trajectories, camera images, pan-tilt view.
+
+The runner calls :meth:`RerunLogger.log` once per tick after ``rr.set_time(...)``. The world is
+logged once (static); poses are two points per tick; the trajectories are re-logged as line
+strips only every ``trail_every`` ticks (decimated), and camera images only every
+``image_every`` ticks and only when the camera grabbed a new frame: logging never renders.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from perception.frame import Frame
+
+if TYPE_CHECKING:
+    from drivers.sim.simulation import Simulation
+
+WALL_COLOUR = (200, 200, 200)
+TRUE_COLOUR = (60, 200, 60)
+ODOM_COLOUR = (230, 120, 40)
+LANDMARK_COLOUR = (80, 140, 255)
+
+
+class RerunLogger:
+    """Per-simulation rerun logging state (what was logged already, tick counter)."""
+
+    def __init__(self, *, image_every: int = 10, trail_every: int = 20, max_trail: int = 2000) -> None:
+        self.image_every = max(1, int(image_every))
+        self.trail_every = max(1, int(trail_every))
+        self.max_trail = max_trail
+        self._ticks = 0
+        self._world_logged = False
+        self._image_stamps: dict[str, float] = {}
+
+    def log(self, sim: Simulation, rec: Any) -> None:
+        """Log this tick; ``rec`` is the ``rerun`` module or a ``rerun.RecordingStream``."""
+        import rerun as rr
+
+        if not self._world_logged:
+            self._log_world(sim, rec, rr)
+            self._world_logged = True
+        true, odom = sim.true_pose(), sim.odometry_in_world()
+        rec.log("world/ground_truth/robot", rr.Points2D([[true.x, true.y]], radii=0.1, colors=[TRUE_COLOUR]))
+        rec.log("world/ground_truth/odometry", rr.Points2D([[odom[0], odom[1]]], radii=0.06, colors=[ODOM_COLOUR]))
+        heading = [[0.4 * math.cos(true.theta), 0.4 * math.sin(true.theta)]]
+        rec.log(
+            "world/ground_truth/heading", rr.Arrows2D(vectors=heading, origins=[[true.x, true.y]], colors=[TRUE_COLOUR])
+        )
+        if sim.ptu is not None:
+            state = sim.ptu.state()
+            direction = true.theta + state.pan
+            reach = 1.5 * math.cos(state.tilt)
+            rec.log(
+                "world/ground_truth/ptu_view",
+                rr.Arrows2D(
+                    vectors=[[reach * math.cos(direction), reach * math.sin(direction)]],
+                    origins=[[true.x, true.y]],
+                    colors=[(255, 220, 0)],
+                ),
+            )
+        if self._ticks % self.trail_every == 0:
+            for name, rows, colour in (
+                ("true", np.asarray(sim.truth.true)[:, 1:3], TRUE_COLOUR),
+                ("odometry", sim.odometry_trajectory_in_world(), ODOM_COLOUR),
+            ):
+                if len(rows) > self.max_trail:
+                    rows = rows[np.linspace(0, len(rows) - 1, self.max_trail).round().astype(int)]
+                rec.log(f"world/ground_truth/trajectory_{name}", rr.LineStrips2D([rows], colors=[colour], radii=0.02))
+        if self._ticks % self.image_every == 0:
+            for name, camera in sim.cameras.items():
+                frame = camera.last
+                if not isinstance(frame, Frame) or self._image_stamps.get(name) == frame.stamp:
+                    continue
+                self._image_stamps[name] = frame.stamp
+                rec.log(f"camera/{name}", rr.Image(frame.image))
+                if frame.right is not None:
+                    rec.log(f"camera/{name}_right", rr.Image(frame.right))
+        self._ticks += 1
+
+    @staticmethod
+    def _log_world(sim: Simulation, rec: Any, rr: Any) -> None:
+        world = sim.world
+        strips = [np.asarray(w.points) for w in world.walls]
+        for p in world.pillars:
+            a = np.linspace(0.0, 2.0 * math.pi, 25)
+            strips.append(np.column_stack([p.x + p.radius * np.cos(a), p.y + p.radius * np.sin(a)]))
+        if strips:
+            rec.log("world/walls", rr.LineStrips2D(strips, colors=[WALL_COLOUR], radii=0.03), static=True)
+        if world.landmarks:
+            xy = [[lm.x, lm.y] for lm in world.landmarks]
+            labels = [str(lm.id) for lm in world.landmarks]
+            rec.log(
+                "world/landmarks", rr.Points2D(xy, radii=0.06, colors=[LANDMARK_COLOUR], labels=labels), static=True
+            )
+        if world.poses:
+            xy = [[p.x, p.y] for p in world.poses.values()]
+            rec.log("world/poses", rr.Points2D(xy, radii=0.05, labels=list(world.poses)), static=True)

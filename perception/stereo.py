@@ -1,0 +1,159 @@
+"""Depth from a rectified parallel stereo pair with a known baseline (room estimation).
+
+Roadmap paper: at each corner of a dodecagon the robot takes a stereo pair of parallel images;
+matches along horizontal epipolar lines give depth ``Z = f * B / d``, hence the free floor space
+and the distance to the scene in every direction. Two ways are offered:
+
+- :func:`sparse_stereo`: features of the left image matched to features of the right image on
+  the same row (``|dv| <= max_dy``) with a positive disparity up to ``max_disparity``. The ratio
+  test is applied among the candidates ALLOWED by that constraint, so repeated texture (several
+  look-alikes on the same epipolar line) is rejected as ambiguous instead of giving wrong depth;
+  the mutual check removes many-to-one matches.
+- :func:`dense_depth`: OpenCV's semi-global matcher (``cv2.StereoSGBM``) with a uniqueness
+  margin (the same idea for every pixel) and left-right consistency.
+
+Both return depths along the optical axis and 3-D points in the rig's body frame (the LEFT
+camera's: x forward, y left, z up).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from perception.camera import StereoRig
+from perception.features import detect
+from perception.matching import DEFAULT_RATIO
+
+
+@dataclass(frozen=True, slots=True)
+class StereoPoints:
+    """Matched points of a stereo pair: left pixels, disparities (px), depths (m), body points."""
+
+    uv_left: np.ndarray
+    disparity: np.ndarray
+    depth: np.ndarray
+    points: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.depth)
+
+
+def points_from_disparity(rig: StereoRig, uv_left: np.ndarray, disparity: np.ndarray) -> StereoPoints:
+    """Triangulate left pixels with their disparities (``Z = fx * B / d``) into body-frame points."""
+    uv = np.asarray(uv_left, dtype=np.float64).reshape(-1, 2)
+    d = np.asarray(disparity, dtype=np.float64).ravel()
+    depth = rig.depth_from_disparity(d)
+    bearings = rig.left.pixel_to_bearing(uv)
+    points = bearings * (depth / bearings[:, 0])[:, None]  # body x is the optical axis: x = Z
+    return StereoPoints(uv, d, depth, points)
+
+
+def sparse_stereo(
+    left: np.ndarray,
+    right: np.ndarray,
+    rig: StereoRig,
+    *,
+    kind: str = "orb",
+    n_features: int = 1000,
+    max_dy: float = 1.5,
+    min_disparity: float = 0.5,
+    max_disparity: float | None = None,
+    ratio: float | None = None,
+) -> StereoPoints:
+    """Feature matches along horizontal epipolar lines (see the module docstring)."""
+    max_disparity = rig.width / 2 if max_disparity is None else max_disparity
+    levels = 1 if kind == "orb" else None  # same scale in both views: full-resolution positions
+    fl = detect(left, kind, n_features=n_features, upright=True, levels=levels)
+    fr = detect(right, kind, n_features=n_features, upright=True, levels=levels)
+    empty = points_from_disparity(rig, np.zeros((0, 2)), np.zeros(0))
+    if len(fl) == 0 or len(fr) == 0:
+        return empty
+    disparity = fl.keypoints_uv[:, None, 0] - fr.keypoints_uv[None, :, 0]
+    dy = np.abs(fl.keypoints_uv[:, None, 1] - fr.keypoints_uv[None, :, 1])
+    allowed = ((dy <= max_dy) & (disparity >= min_disparity) & (disparity <= max_disparity)).astype(np.uint8)
+    norm = cv2.NORM_HAMMING if fl.binary else cv2.NORM_L2
+    matcher = cv2.BFMatcher(norm)
+    ratio = DEFAULT_RATIO.get(kind, 0.75) if ratio is None else ratio
+    left_idx, right_idx = [], []
+    for candidates in matcher.knnMatch(fl.descriptors, fr.descriptors, k=2, mask=allowed):
+        if not candidates:
+            continue
+        if len(candidates) == 2 and not candidates[0].distance < ratio * candidates[1].distance:
+            continue  # two look-alikes on the same epipolar line: repeated texture, ambiguous
+        left_idx.append(candidates[0].queryIdx)
+        right_idx.append(candidates[0].trainIdx)
+    if not left_idx:
+        return empty
+    li, ri = np.array(left_idx), np.array(right_idx)
+    back = matcher.knnMatch(fr.descriptors, fl.descriptors, k=1, mask=np.ascontiguousarray(allowed.T))
+    nearest_left = np.full(len(fr), -1)
+    for candidates in back:
+        if candidates:
+            nearest_left[candidates[0].queryIdx] = candidates[0].trainIdx
+    keep = nearest_left[ri] == li  # mutual check
+    li, ri = li[keep], ri[keep]
+    if len(li) == 0:
+        return empty
+    uv_left = _subpixel(left, fl.keypoints_uv[li])
+    uv_right = _subpixel(right, fr.keypoints_uv[ri])
+    d = uv_left[:, 0] - uv_right[:, 0]
+    ok = (d >= min_disparity) & (np.abs(uv_left[:, 1] - uv_right[:, 1]) <= max_dy)
+    return points_from_disparity(rig, uv_left[ok], d[ok])
+
+
+def _subpixel(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Corner positions refined to sub-pixel accuracy (``cv2.cornerSubPix``) for finer disparities."""
+    gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
+    corners = uv.astype(np.float32).reshape(-1, 1, 2).copy()
+    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 20, 0.01)
+    refined = cv2.cornerSubPix(gray, corners, (3, 3), (-1, -1), criteria).reshape(-1, 2).astype(np.float64)
+    moved = np.linalg.norm(refined - uv, axis=1) > 1.5  # a refinement that wandered off: keep the detection
+    refined[moved] = uv[moved]
+    return refined
+
+
+def dense_depth(
+    left: np.ndarray,
+    right: np.ndarray,
+    rig: StereoRig,
+    *,
+    num_disparities: int = 64,
+    block_size: int = 5,
+    uniqueness: int = 15,
+) -> np.ndarray:
+    """Depth map (m, float32, left-image sized; NaN where no reliable disparity) by StereoSGBM.
+
+    ``uniqueness`` is OpenCV's ``uniquenessRatio`` (percent by which the best cost must beat the
+    second best): the guard against repeated texture. ``num_disparities`` is rounded up to 16.
+    """
+    num = int(np.ceil(num_disparities / 16.0) * 16)
+    gray = [cv2.cvtColor(im, cv2.COLOR_BGR2GRAY) if im.ndim == 3 else im for im in (left, right)]
+    matcher = cv2.StereoSGBM_create(
+        minDisparity=0,
+        numDisparities=num,
+        blockSize=block_size,
+        P1=8 * block_size**2,
+        P2=32 * block_size**2,
+        disp12MaxDiff=1,
+        uniquenessRatio=uniqueness,
+        speckleWindowSize=50,
+        speckleRange=2,
+    )
+    disparity = matcher.compute(gray[0], gray[1]).astype(np.float32) / 16.0  # fixed point, 4 bits
+    depth = np.full(disparity.shape, np.nan, dtype=np.float32)
+    valid = disparity > 0
+    depth[valid] = rig.left.fx * rig.baseline / disparity[valid]
+    return depth
+
+
+def dense_points(depth: np.ndarray, rig: StereoRig, *, step: int = 4) -> np.ndarray:
+    """Body-frame points (M x 3) of a depth map, sampled every ``step`` pixels, NaNs dropped."""
+    vs, us = np.mgrid[0 : depth.shape[0] : step, 0 : depth.shape[1] : step]
+    z = depth[vs, us].ravel()
+    ok = np.isfinite(z)
+    uv = np.column_stack((us.ravel()[ok], vs.ravel()[ok])).astype(np.float64)
+    bearings = rig.left.pixel_to_bearing(uv)
+    return bearings * (z[ok] / bearings[:, 0])[:, None]

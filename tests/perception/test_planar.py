@@ -1,0 +1,114 @@
+"""Planar essential-matrix homing on synthetic pinhole views with known motion."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from perception.planar import (
+    distance_from_third_image,
+    estimate_planar_motion,
+    planar_essential,
+    rotation_y,
+)
+from perception.synthetic import make_planar_scene
+
+
+def direction_error_deg(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.degrees(np.arccos(np.clip(np.dot(a, b) / np.linalg.norm(a) / np.linalg.norm(b), -1, 1))))
+
+
+@pytest.mark.parametrize(
+    ("theta_deg", "displacement"),
+    [(10.0, (0.3, 1.0)), (-25.0, (1.0, 0.2)), (0.0, (-0.5, 0.5)), (30.0, (0.0, -1.0)), (-5.0, (0.2, -0.6))],
+)
+def test_turn_and_direction_recovered_with_sign(theta_deg, displacement):
+    scene = make_planar_scene(1, theta_deg=theta_deg, displacement=displacement)
+    result = estimate_planar_motion(scene.ref, scene.cur)
+    assert result.ok and result.moved
+    assert np.degrees(abs(result.theta - scene.theta)) < 0.01
+    assert direction_error_deg(result.direction, scene.displacement) < 0.01  # forward/backward right
+    assert result.inliers.all()
+    assert result.votes > 0.9
+
+
+def test_essential_matrix_satisfies_the_epipolar_constraint():
+    scene = make_planar_scene(2, theta_deg=12.0, displacement=(0.4, 0.9))
+    E = planar_essential(scene.theta, scene.displacement)
+    ref_h = np.column_stack((scene.ref, np.ones(len(scene.ref))))
+    cur_h = np.column_stack((scene.cur, np.ones(len(scene.cur))))
+    assert np.abs(np.einsum("ni,ij,nj->n", cur_h, E, ref_h)).max() < 1e-12
+    assert np.allclose(rotation_y(0.3) @ rotation_y(-0.3), np.eye(3))
+
+
+def test_pure_rotation_reports_the_turn_and_no_direction():
+    scene = make_planar_scene(3, theta_deg=-20.0, displacement=(0.0, 0.0))
+    result = estimate_planar_motion(scene.ref, scene.cur)
+    assert result.ok and not result.moved
+    assert np.degrees(abs(result.theta - scene.theta)) < 0.01
+    assert np.array_equal(result.direction, np.zeros(2))
+
+
+def test_pure_translation():
+    scene = make_planar_scene(4, theta_deg=0.0, displacement=(-0.2, 1.0))
+    result = estimate_planar_motion(scene.ref, scene.cur)
+    assert result.ok and result.moved and abs(result.theta) < 1e-6
+    assert direction_error_deg(result.direction, scene.displacement) < 0.01
+    assert result.bearing == pytest.approx(np.arctan2(0.2, 1.0), abs=1e-6)  # left-positive body azimuth
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_half_outliers_and_noise(seed):
+    scene = make_planar_scene(seed, theta_deg=15.0, displacement=(0.5, 0.8), noise=1e-3, outlier_fraction=0.5)
+    result = estimate_planar_motion(scene.ref, scene.cur, rng=seed)
+    assert result.ok
+    assert np.degrees(abs(result.theta - scene.theta)) < 0.2
+    assert direction_error_deg(result.direction, scene.displacement) < 3.0
+    assert (result.inliers & scene.outlier).sum() <= 0.05 * scene.outlier.sum()
+    assert result.inliers[~scene.outlier].mean() > 0.9
+
+
+def test_too_few_points_or_only_junk():
+    scene = make_planar_scene(5, n=60)
+    assert not estimate_planar_motion(scene.ref[:5], scene.cur[:5]).ok
+    rng = np.random.default_rng(0)
+    junk = estimate_planar_motion(rng.uniform(-1, 1, (60, 2)), rng.uniform(-1, 1, (60, 2)))
+    assert not junk.ok and not junk.inliers.any()
+
+
+def test_points_at_camera_height_cannot_give_a_motion():
+    scene = make_planar_scene(8, theta_deg=10.0, displacement=(0.3, 1.0))
+    flat_ref = scene.ref * [1.0, 0.0]  # every point on the horizon row in both views
+    flat_cur = scene.cur * [1.0, 0.0]
+    assert not estimate_planar_motion(flat_ref, flat_cur).ok
+    assert estimate_planar_motion(scene.ref, scene.cur).ok
+
+
+def _project(points: np.ndarray, position: np.ndarray, theta: float) -> np.ndarray:
+    q = (points - np.array([position[0], 0.0, position[1]])) @ rotation_y(theta).T
+    return q[:, :2] / q[:, 2:]
+
+
+def test_distance_from_a_third_image_after_a_sideways_step():
+    rng = np.random.default_rng(6)
+    points = np.column_stack((rng.uniform(-4, 4, 300), rng.uniform(-1, 1, 300), rng.uniform(6, 10, 300)))
+    target = np.array([0.4, 2.0])  # target camera at (x, z), facing forward
+    step, turn = np.array([0.5, 0.0]), np.radians(-5.0)
+    first = estimate_planar_motion(_project(points, np.zeros(2), 0.0), _project(points, target, 0.0))
+    second = estimate_planar_motion(_project(points, step, turn), _project(points, target, 0.0))
+    found = distance_from_third_image(first, second, step, turn)
+    assert found.ok
+    assert found.from_first == pytest.approx(np.linalg.norm(target), rel=1e-3)
+    assert found.from_second == pytest.approx(np.linalg.norm(target - step), rel=1e-3)
+    assert np.allclose(found.target_xz, target, atol=1e-3)
+
+
+def test_distance_refused_without_parallax():
+    rng = np.random.default_rng(7)
+    points = np.column_stack((rng.uniform(-4, 4, 300), rng.uniform(-1, 1, 300), rng.uniform(6, 10, 300)))
+    target = np.array([0.0, 2.0])
+    step = np.array([0.0, 0.5])  # straight towards the target: the rays coincide
+    first = estimate_planar_motion(_project(points, np.zeros(2), 0.0), _project(points, target, 0.0))
+    second = estimate_planar_motion(_project(points, step, 0.0), _project(points, target, 0.0))
+    assert first.ok and second.ok
+    assert not distance_from_third_image(first, second, step).ok

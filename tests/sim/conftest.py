@@ -1,0 +1,33 @@
+"""Fixtures for the simulator tests: small worlds written as YAML, like a user would."""
+
+from __future__ import annotations
+
+import textwrap
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from drivers.sim.simulation import Simulation
+
+
+@pytest.fixture
+def world_file(tmp_path: Path) -> Callable[[str], Path]:
+    """Write dedented YAML text to a world file and return its path."""
+
+    def write(text: str, name: str = "world.yaml") -> Path:
+        path = tmp_path / name
+        path.write_text(textwrap.dedent(text))
+        return path
+
+    return write
+
+
+@pytest.fixture
+def sim_from(world_file: Callable[[str], Path]) -> Callable[..., Simulation]:
+    """Load a simulation from YAML text."""
+
+    def load(text: str, seed: int = 0, **options: object) -> Simulation:
+        return Simulation.load(world_file(text), seed=seed, **options)
+
+    return load
