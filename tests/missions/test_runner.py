@@ -200,3 +200,25 @@ class _NoWorld:
 
     def log_rerun(self, rr) -> None:
         pass
+
+
+def test_showcase_in_the_lab_is_deterministic_on_rendered_pixels(tmp_path):
+    def run(name: str) -> dict:
+        path = tmp_path / f"{name}.json"
+        code = main(["run", "showcase", "--sim", "lab", "--seed", "5", "--max-time", "4", "--quiet",
+                     "--report", str(path)])
+        assert code == 1  # cut short by --max-time ...
+        data = json.loads(path.read_text())
+        assert data["reason"] == "time limit of 4 s reached"  # ... and not blind: the guard held
+        data.pop("wall_time_s")
+        return data
+
+    first, second = run("a"), run("b")
+    assert first == second
+    assert first["ground_truth"]["trajectory_length_m"] > 0.5
+
+
+def test_a_mission_needing_a_camera_the_world_lacks_is_invalid(write_mission, capsys):
+    path = write_mission("cameras: [periscope]\ntree: Stop\n")
+    assert main(["run", str(path), "--sim", "lab", "--quiet"]) == 2
+    assert "the mission uses camera(s) periscope, which world lab does not have" in capsys.readouterr().err
