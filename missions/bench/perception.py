@@ -236,7 +236,7 @@ def zinf_figures(quick: bool) -> dict[str, Any]:
             add("opencv_translation_error_deg", angle_deg(c, scene.position))
 
     out: dict[str, Any] = {"zinf_trials": trials, "zinf_correspondences": 300}
-    for key in (
+    out.update(_medians(rows, (
         "zinf_ms",
         "zinf_rotation_error_deg",
         "zinf_translation_error_deg",
@@ -246,14 +246,7 @@ def zinf_figures(quick: bool) -> dict[str, Any]:
         "opencv_essential_ms",
         "opencv_rotation_error_deg",
         "opencv_translation_error_deg",
-    ):
-        values = rows.get(key)
-        if not values:
-            out[key] = None
-        elif key.endswith("_ms"):
-            out[key] = _median_ms(values)
-        else:
-            out[key] = round(float(np.median(values)), 4)
+    )))
     out["zinf_ok_fraction"] = round(float(np.mean(rows["zinf_ok"])), 3)
     out["pinhole_correspondences"] = round(float(np.mean(rows["pinhole_correspondences"])), 1)
     return out
@@ -317,14 +310,21 @@ def planar_figures(quick: bool) -> dict[str, Any]:
             rows.setdefault("poselib_planar_theta_error_deg", []).append(abs(np.degrees(theta - scene.theta)))
             rows.setdefault("poselib_planar_direction_error_unsigned_deg", []).append(min(err, 180.0 - err))
     out: dict[str, Any] = {"planar_trials": trials}
-    for key in (
+    out.update(_medians(rows, (
         "planar_ms",
         "planar_theta_error_deg",
         "planar_direction_error_deg",
         "poselib_planar_ms",
         "poselib_planar_theta_error_deg",
         "poselib_planar_direction_error_unsigned_deg",
-    ):
+    )))
+    return out
+
+
+def _medians(rows: dict[str, list], keys: tuple[str, ...]) -> dict[str, float | None]:
+    """The median of each named series (times via ``_median_ms``); None for a series never measured."""
+    out: dict[str, float | None] = {}
+    for key in keys:
         values = rows.get(key)
         if not values:
             out[key] = None
