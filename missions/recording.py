@@ -41,7 +41,7 @@ class Recorder:
         if command is not None:
             rr.log("robot/command/v", rr.Scalars([command.v]))
             rr.log("robot/command/w", rr.Scalars([command.w]))
-        for path, node in _paths(root):
+        for path, node in _walk(root, "", {}):
             rr.log(f"tree/{path}", rr.Scalars([STATUS_CODE[node.status]]))
             if self._last_status.get(path) != node.status:
                 self._last_status[path] = node.status
@@ -55,14 +55,8 @@ class Recorder:
         self.rr.disconnect()
 
 
-def _paths(root: py_trees.behaviour.Behaviour, prefix: str = ""):
-    """(entity path, node) for every node, the path made of sanitised, de-duplicated names."""
-    seen: dict[str, int] = {}
-    for child in [root]:
-        yield from _walk(child, prefix, seen)
-
-
 def _walk(node: py_trees.behaviour.Behaviour, prefix: str, seen: dict[str, int]):
+    """(entity path, node) for a node and its subtree; paths are sanitised, de-duplicated names."""
     name = "".join(c if c.isalnum() or c in "-_" else "_" for c in node.name) or "node"
     path = f"{prefix}/{name}" if prefix else name
     count = seen.get(path, 0)

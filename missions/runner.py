@@ -96,7 +96,6 @@ class Runner:
         self.blackboard = py_trees.blackboard.Client(name="runner")
         for key in COMMAND_KEYS:
             self.blackboard.register_key(key=key, access=py_trees.common.Access.WRITE)
-        self.blackboard.register_key(key="/robot/odometry", access=py_trees.common.Access.READ)
 
     # -- control -------------------------------------------------------------------------------
     def request_stop(self, reason: str) -> None:

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from maps.store import Diagnostic, InputError
-from missions.commands.common import EXIT_INVALID, add_mission_options, load_from_args, print_input_error
+from missions.commands.common import add_mission_options, load_from_args, print_input_error
 from missions.runner import Runner, RunOptions
 
 DESCRIPTION = """Run a mission until its tree ends in SUCCESS or FAILURE.
@@ -101,11 +101,7 @@ def _open(args: argparse.Namespace):
 
     try:
         simulation = Simulation.load(args.sim, seed=args.seed)
-    except InputError:
-        raise
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError) as exc:  # InputError (a bad world file) passes through as it is
         raise InputError([Diagnostic(str(args.sim), 0, 0, str(exc))]) from None
     return simulation, simulation.robot
 
-
-__all__ = ["register", "run", "EXIT_INVALID"]
