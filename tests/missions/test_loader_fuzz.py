@@ -3,16 +3,13 @@ diagnostics, never another exception (so the CLI never shows a traceback)."""
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from maps.store import InputError
 from missions.language import MissionSpec
 from missions.loader import LIBRARY, load_mission
+from tests.fuzzing import load_or_diagnose
 
 SHIPPED = sorted(p.read_text(encoding="utf-8") for p in LIBRARY.glob("*.yaml"))
 NAMES = ["Sequence", "Selector", "Parallel", "Drive", "Rotate", "Wait", "Timeout", "Retry", "Repeat",
@@ -22,18 +19,8 @@ SETTINGS = settings(max_examples=300, deadline=None, suppress_health_check=[Heal
 
 
 def load_text(data: bytes) -> None:
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / "fuzz.yaml"
-        path.write_bytes(data)
-        try:
-            result = load_mission(path)
-        except InputError as exc:
-            assert exc.diagnostics
-            for diagnostic in exc.diagnostics:
-                assert isinstance(diagnostic.message, str) and diagnostic.message
-                assert diagnostic.line >= 0 and diagnostic.col >= 0
-        else:
-            assert isinstance(result, MissionSpec)
+    result = load_or_diagnose(data, load_mission, name="fuzz.yaml")
+    assert result is None or isinstance(result, MissionSpec)
 
 
 @st.composite

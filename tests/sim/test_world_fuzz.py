@@ -3,16 +3,13 @@ render, never another exception."""
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from drivers.sim.simulation import Simulation
 from drivers.sim.world import World, load_world, shipped_worlds
-from maps.store import InputError
+from tests.fuzzing import load_or_diagnose
 
 SHIPPED = sorted(p.read_text(encoding="utf-8") for p in shipped_worlds().values())
 KEYS = ["name", "start", "poses", "walls", "boxes", "pillars", "landmarks", "cameras", "ptu", "lighting", "points",
@@ -22,20 +19,15 @@ SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[Heal
 
 
 def load_text(data: bytes) -> None:
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / "world.yaml"
-        path.write_bytes(data)
-        try:
-            world = load_world(path)
-        except InputError as exc:
-            assert exc.diagnostics and all(d.message for d in exc.diagnostics)
-        else:
-            assert isinstance(world, World)
-            sim = Simulation(world, seed=0)
-            sim.robot.base.drive(0.3, 0.2)
-            sim.step(0.1)
-            for camera in sim.robot.cameras.values():
-                camera.grab()
+    world = load_or_diagnose(data, load_world, name="world.yaml")
+    if world is None:
+        return
+    assert isinstance(world, World)
+    sim = Simulation(world, seed=0)
+    sim.robot.base.drive(0.3, 0.2)
+    sim.step(0.1)
+    for camera in sim.robot.cameras.values():
+        camera.grab()
 
 
 @st.composite
