@@ -3,7 +3,7 @@
 A :class:`SimCamera` implements :class:`~drivers.interfaces.Camera`. ``grab()`` renders at the
 simulation's current true pose and pan-tilt state and stamps the frame with simulated time;
 image cameras return a :class:`~perception.frame.Frame`, the ``bearings`` sensor a
-:class:`~drivers.sim.sensors.LandmarkBearings`. Frame drops, exposure noise and the per-run
+:class:`~perception.frame.LandmarkBearings`. Frame drops, exposure noise and the per-run
 lighting change are applied here, after rendering, so geometry tests see clean images.
 """
 
@@ -18,10 +18,10 @@ import numpy as np
 
 from drivers.sim.render import CameraRenderer
 from drivers.sim.scene import Scene
-from drivers.sim.sensors import BearingSensorModel, LandmarkBearings, observe_landmarks
+from drivers.sim.sensors import BearingSensorModel, observe_landmarks
 from drivers.sim.world import CameraSpec, Lighting, PtuSpec
 from perception.camera import StereoRig
-from perception.frame import Frame
+from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
 
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from drivers.sim.scene import Scene
 from drivers.sim.world import CameraSpec
-from perception.frame import LandmarkBearings  # noqa: F401  (re-exported: the sensor's output)
+from perception.frame import LandmarkBearings
 
 
 @dataclass(frozen=True, slots=True)

@@ -27,10 +27,9 @@ from drivers.sim.cameras import SimCamera, run_lighting
 from drivers.sim.kinematics import DiffDrive, DiffDriveLimits, SlipModel
 from drivers.sim.ptu import SimPanTilt
 from drivers.sim.scene import Scene
-from drivers.sim.sensors import LandmarkBearings
 from drivers.sim.visualise import RerunLogger
 from drivers.sim.world import World, empty_world, load_world
-from perception.frame import Frame
+from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
 
 
