@@ -32,8 +32,8 @@ class Perceive(BearingsBehaviour):
     READS = ("/perception/frames", "/perception/frame")
     WRITES = ("/perception/observation",)
 
-    def setup(self, **kwargs) -> None:
-        super().setup(**kwargs)
+    def __init__(self, name: str | None = None, **params) -> None:
+        super().__init__(name=name, **params)
         self._last_stamp: tuple[str, float] | None = None
 
     def update(self) -> Status:
@@ -43,7 +43,7 @@ class Perceive(BearingsBehaviour):
             self.feedback_message = f"no frame from {name or 'the camera'} yet"
             return Status.SUCCESS  # nothing to perceive is not a failure of perception
         stamp = (frame.camera_name, frame.stamp)
-        if stamp != getattr(self, "_last_stamp", None):
+        if stamp != self._last_stamp:
             self._last_stamp = stamp
             if isinstance(frame, LandmarkBearings):
                 observation = from_landmark_bearings(frame)

@@ -68,12 +68,17 @@ class GrabFrames(_Sensor):
         super().__init__(name=name)
         self.only = cameras
 
+    def setup(self, **kwargs: Any) -> None:
+        super().setup(**kwargs)
+        if self.only is not None and getattr(self, "_robot", None) is not None:
+            missing = self._robot.missing_cameras(self.only)
+            if missing:
+                have = ", ".join(self._robot.cameras) or "none"
+                raise KeyError(f"the robot has no camera {', '.join(missing)} (it has: {have})")
+
     def update(self) -> Status:
         cameras = self.robot.cameras
         if self.only is not None:
-            missing = [c for c in self.only if c not in cameras]
-            if missing:
-                raise KeyError(f"the robot has no camera {', '.join(missing)} (it has: {', '.join(cameras) or 'none'})")
             cameras = {name: cameras[name] for name in self.only}
         if not cameras:
             return Status.SUCCESS

@@ -7,6 +7,7 @@ mission cannot tell them apart. Units are SI: metres, seconds, radians.
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
@@ -106,6 +107,10 @@ class Robot:
     ptu: PanTilt | None = None
     cameras: dict[str, Camera] = field(default_factory=dict)
     name: str = "robot"
+
+    def missing_cameras(self, names: Iterable[str]) -> list[str]:
+        """The names among ``names`` that are not cameras of this robot."""
+        return [name for name in names if name not in self.cameras]
 
     def stop_all(self) -> None:
         """Command every actuator to rest; never raises so it can run on any error path."""

@@ -49,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
         simulation, robot = _open(args)
     except InputError as exc:
         return print_input_error(exc)
-    missing = [c for c in mission.cameras or () if c not in robot.cameras]
+    missing = robot.missing_cameras(mission.cameras or ())
     if missing:
         robot.close()
         where = args.robot or f"world {args.sim or 'empty'}"

@@ -222,3 +222,12 @@ def test_a_mission_needing_a_camera_the_world_lacks_is_invalid(write_mission, ca
     path = write_mission("cameras: [periscope]\ntree: Stop\n")
     assert main(["run", str(path), "--sim", "lab", "--quiet"]) == 2
     assert "the mission uses camera(s) periscope, which world lab does not have" in capsys.readouterr().err
+
+
+def test_runner_refuses_a_missing_camera_at_setup_before_any_motion(write_mission):
+    mission = load_mission(write_mission("cameras: [periscope]\ntree: {Drive: {distance: 1.0}}\n"))
+    robot = fake_robot(cameras=("front",))
+    result = Runner(mission, robot, simulation=_NoWorld()).run()
+    assert result.status == "FAILURE" and result.ticks == 0
+    assert "has no camera periscope (it has: front)" in result.reason
+    assert robot.base.commands == [(0.0, 0.0)]
