@@ -168,14 +168,11 @@ class Simulation:
 
     def odometry_in_world(self) -> np.ndarray:
         """Where odometry believes the robot is, as world (x, y): odometry starts at the true start."""
-        return _odom_in_world(np.asarray(self.truth.true[0]), np.asarray(self.truth.odometry[-1]))
+        return _start_to_world(self.truth.true[0], np.asarray(self.truth.odometry[-1:])[:, 1:3])[0]
 
     def odometry_trajectory_in_world(self) -> np.ndarray:
         """The whole odometry trajectory as world (x, y) rows."""
-        _, x0, y0, th0 = self.truth.true[0]
-        odom = np.asarray(self.truth.odometry)[:, 1:3]
-        c, s = math.cos(th0), math.sin(th0)
-        return np.column_stack([x0 + c * odom[:, 0] - s * odom[:, 1], y0 + s * odom[:, 0] + c * odom[:, 1]])
+        return _start_to_world(self.truth.true[0], np.asarray(self.truth.odometry)[:, 1:3])
 
     def ground_truth_report(
         self,
@@ -196,13 +193,9 @@ class Simulation:
         if frame not in ("world", "start"):
             raise ValueError(f"frame must be 'world' or 'start', got {frame!r}")
         true = np.asarray(self.truth.true, dtype=float)
-        odom = np.asarray(self.truth.odometry, dtype=float)
         xy = true[:, 1:3]
         if frame == "start":  # express the trajectory in the start frame instead
-            _, x0, y0, th0 = true[0]
-            c, s = math.cos(th0), math.sin(th0)
-            rel = xy - (x0, y0)
-            xy = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])
+            xy = _world_to_start(true[0], xy)
         report: dict = {
             "world": self.name,
             "seed": self.seed,
@@ -210,7 +203,7 @@ class Simulation:
             "evaluation_frame": frame,
             "trajectory_length_m": float(np.sum(np.linalg.norm(np.diff(xy, axis=0), axis=1))),
             "final_pose": {"x": float(true[-1, 1]), "y": float(true[-1, 2]), "theta": float(true[-1, 3])},
-            "odometry_drift_m": float(np.linalg.norm(true[-1, 1:3] - _odom_in_world(true[0], odom[-1]))),
+            "odometry_drift_m": float(np.linalg.norm(true[-1, 1:3] - self.odometry_in_world())),
             "collisions": int(self.collisions),
             "stalled_time_s": float(self._stalled_time),
             "trajectory": _decimate(true, max_points=2000),
@@ -280,17 +273,19 @@ def path_distances(trajectory_xy: np.ndarray, reference_xy: np.ndarray) -> np.nd
     return np.linalg.norm(p - closest, axis=2).min(axis=1)
 
 
-def path_error(trajectory_xy: np.ndarray, reference_xy: np.ndarray) -> float:
-    """Mean distance (m) from the trajectory's points to the reference polyline."""
-    return float(path_distances(trajectory_xy, reference_xy).mean())
-
-
-def _odom_in_world(true_start: np.ndarray, odom_end: np.ndarray) -> np.ndarray:
-    """Where the robot believes it is, in the world frame (odometry starts at the true start)."""
-    _, x0, y0, th0 = true_start
-    _, ox, oy, _ = odom_end
+def _start_to_world(start: Sequence[float], xy: np.ndarray) -> np.ndarray:
+    """(x, y) rows given in the frame of the start row (t, x, y, theta), in the world frame."""
+    _, x0, y0, th0 = start
     c, s = math.cos(th0), math.sin(th0)
-    return np.array([x0 + c * ox - s * oy, y0 + s * ox + c * oy])
+    return np.column_stack([x0 + c * xy[:, 0] - s * xy[:, 1], y0 + s * xy[:, 0] + c * xy[:, 1]])
+
+
+def _world_to_start(start: Sequence[float], xy: np.ndarray) -> np.ndarray:
+    """The inverse of :func:`_start_to_world`."""
+    _, x0, y0, th0 = start
+    c, s = math.cos(th0), math.sin(th0)
+    rel = xy - (x0, y0)
+    return np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])
 
 
 def _decimate(rows: np.ndarray, *, max_points: int) -> list[list[float]]:
