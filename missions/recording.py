@@ -36,7 +36,8 @@ class Recorder:
         rr.set_time(self.timeline, duration=time_s)
         rr.set_time("tick", sequence=tick)
         if odometry is not None:
-            rr.log("world/robot/odometry", rr.Points2D([[odometry.x, odometry.y]], radii=0.04))
+            # the odometry frame is not the world frame: its own space, so views never mix the two
+            rr.log("odometry_frame/robot", rr.Points2D([[odometry.x, odometry.y]], radii=0.04))
             rr.log("robot/odometry/theta", rr.Scalars([odometry.theta]))
         if command is not None:
             rr.log("robot/command/v", rr.Scalars([command.v]))
