@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import argparse
 import re
-import sys
 from pathlib import Path
 
 import cv2
 
 from maps.store import write_yaml
+from missions.commands.common import fail
 from perception.calibration import calibrate_chessboard
 
 DESCRIPTION = """Calibrate a pinhole camera (focal lengths, principal point and 5 OpenCV distortion
@@ -68,33 +68,30 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def _fail(message: str) -> int:
-    print(f"bearings calibrate: {message}", file=sys.stderr)
-    return 2
-
 
 def run(args: argparse.Namespace) -> int:
     match = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", args.board)
     if not match:
-        return _fail(f"--board must look like 9x6 (inner corners), got {args.board!r}")
+        return fail("calibrate", f"--board must look like 9x6 (inner corners), got {args.board!r}")
     columns, rows = int(match.group(1)), int(match.group(2))
     if not args.square > 0:
-        return _fail(f"--square must be a positive length in metres, got {args.square}")
+        return fail("calibrate", f"--square must be a positive length in metres, got {args.square}")
     images = []
     for name in args.images:
         if not Path(name).is_file():
-            return _fail(f"{name}: no such file")
+            return fail("calibrate", f"{name}: no such file")
         image = cv2.imread(name, cv2.IMREAD_GRAYSCALE)
         if image is None:
-            return _fail(f"{name}: not an image OpenCV can read")
+            return fail("calibrate", f"{name}: not an image OpenCV can read")
         images.append(image)
     sizes = {image.shape for image in images}
     if len(sizes) > 1:
-        return _fail("all images must have the same size, got " + ", ".join(f"{w}x{h}" for h, w in sorted(sizes)))
+        found = ", ".join(f"{w}x{h}" for h, w in sorted(sizes))
+        return fail("calibrate", f"all images must have the same size, got {found}")
     try:
         result = calibrate_chessboard(images, columns, rows, args.square, fix_aspect_ratio=args.fix_aspect)
     except ValueError as exc:
-        return _fail(str(exc))
+        return fail("calibrate", str(exc))
     data = {
         **result.camera.to_dict(),
         "calibration": {
@@ -108,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         write_yaml(args.output, data, header="camera calibration written by 'bearings calibrate'")
     except OSError as exc:
-        return _fail(f"{args.output}: cannot write: {exc.strerror or exc}")
+        return fail("calibrate", f"{args.output}: cannot write: {exc.strerror or exc}")
     cam = result.camera
     print(f"calibrated from {result.images_used} of {len(images)} images ({result.images_rejected} rejected)")
     for i in result.rejected:

@@ -46,3 +46,9 @@ def print_input_error(exc: InputError) -> int:
     count = len(exc.diagnostics)
     print(f"{count} problem{'s' if count != 1 else ''} found", file=sys.stderr)
     return EXIT_INVALID
+
+
+def fail(command: str, message: str) -> int:
+    """Report invalid input of a sub-command in one line on stderr; the exit code for it."""
+    print(f"bearings {command}: {message}", file=sys.stderr)
+    return EXIT_INVALID

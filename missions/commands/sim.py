@@ -8,14 +8,13 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from pathlib import Path
 
 import cv2
 import numpy as np
 
 from maps.store import InputError, write_bytes_atomic
-from missions.commands.common import EXIT_INVALID, EXIT_OK, print_input_error
+from missions.commands.common import EXIT_INVALID, EXIT_OK, fail, print_input_error
 
 SNAPSHOT_DESCRIPTION = """Render the image a simulated camera sees with the robot at a given TRUE pose, and
 write it as an image file (PNG, or any format OpenCV writes, chosen by the file extension). A stereo
@@ -71,10 +70,6 @@ def _help(parser: argparse.ArgumentParser) -> int:
     return EXIT_INVALID
 
 
-def _fail(message: str) -> int:
-    print(f"bearings sim: {message}", file=sys.stderr)
-    return EXIT_INVALID
-
 
 def parse_pose(text: str, named: dict) -> object:
     """``x,y,theta`` (theta in rad, or degrees with a ``deg`` suffix) or a named pose."""
@@ -110,16 +105,16 @@ def run_snapshot(args: argparse.Namespace) -> int:
     try:
         pose = parse_pose(args.pose, named)
     except ValueError as exc:
-        return _fail(str(exc))
+        return fail("sim", str(exc))
     if args.camera not in sim.cameras:
-        return _fail(f"no camera {args.camera!r} in world {sim.name!r} (cameras: {', '.join(sim.cameras)})")
+        return fail("sim", f"no camera {args.camera!r} in world {sim.name!r} (cameras: {', '.join(sim.cameras)})")
     camera = sim.cameras[args.camera]
     if not camera.is_image:
         images = [n for n, c in sim.cameras.items() if c.is_image]
-        return _fail(f"camera {args.camera!r} is a bearings sensor and makes no image (image cameras: "
+        return fail("sim", f"camera {args.camera!r} is a bearings sensor and makes no image (image cameras: "
                      f"{', '.join(images)})")  # fmt: skip
     if not (math.isfinite(args.pan) and math.isfinite(args.tilt)):
-        return _fail("--pan and --tilt must be finite")
+        return fail("sim", "--pan and --tilt must be finite")
     frame = sim.snapshot(pose, args.camera, pan=math.radians(args.pan), tilt=math.radians(args.tilt))
     image = frame.image if frame.right is None else np.hstack([frame.image, frame.right])
     suffix = Path(args.output).suffix.lower() or ".png"
@@ -128,11 +123,11 @@ def run_snapshot(args: argparse.Namespace) -> int:
     except cv2.error:
         ok = False
     if not ok:
-        return _fail(f"cannot encode an image as {suffix!r}: use .png (or another format OpenCV writes)")
+        return fail("sim", f"cannot encode an image as {suffix!r}: use .png (or another format OpenCV writes)")
     try:
         write_bytes_atomic(args.output, encoded.tobytes())
     except OSError as exc:
-        return _fail(f"cannot write {args.output}: {exc.strerror or exc}")
+        return fail("sim", f"cannot write {args.output}: {exc.strerror or exc}")
     print(f"wrote {args.output} ({image.shape[1]} x {image.shape[0]}, camera {args.camera!r} of {sim.name!r})")
     return EXIT_OK
 
