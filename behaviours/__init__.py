@@ -1,8 +1,7 @@
 """py_trees behaviours for bearings missions.
 
 Behaviours read and write the blackboards and never touch hardware: the runner turns
-``/robot/command`` and ``/ptu/command`` into driver calls after each tick. Importing this package
-registers every built-in node type with :mod:`behaviours.registry`.
+``/robot/command`` and ``/ptu/command`` into driver calls after each tick. Node types are
+declared once (:mod:`behaviours.registry`, :mod:`behaviours.ports`) and collected into a
+:class:`~behaviours.registry.Registry` per mission load.
 """
-
-from behaviours import builtin as _builtin  # noqa: F401  (registers the node types)

@@ -1,8 +1,10 @@
-"""The base class of bearings behaviours: declared ports, blackboard access and the clock.
+"""The base class of bearings leaf behaviours: declared ports, blackboard access and the clock.
 
-A behaviour declares ``PARAMS`` (typed parameters), ``READS`` and ``WRITES`` (blackboard keys)
-as class attributes; the mission loader checks a mission against them before anything ticks, and
-the blackboard client only grants access to the declared keys.
+A behaviour declares its ports once (``PORTS``, see :mod:`behaviours.ports`); the mission loader
+checks a mission against them before anything ticks, and the behaviour's blackboard client is
+granted exactly the keys its ports resolve to: read access for referenced inputs, write access
+for outputs (remapped or not). Inside ``update()`` a behaviour calls :meth:`get_input` and
+:meth:`set_output` (py_trees' own ports use the same names), never a key.
 """
 
 from __future__ import annotations
@@ -13,31 +15,50 @@ import py_trees
 from py_trees.common import Access
 
 from behaviours.clock import Clock
-from behaviours.ports import REQUIRED, Param, Ref, check_value, parse_ref
+from behaviours.ports import (
+    REQUIRED,
+    InputPort,
+    Key,
+    OutputPort,
+    Port,
+    Ref,
+    check_literal,
+    key_problem,
+    matches_type,
+    parse_ref,
+    type_name,
+)
+from behaviours.registry import Declared, Kind
+
+_UNSET: Any = object()
 
 
 class NotSetUp(RuntimeError):
     """A behaviour ticked before ``setup(clock=...)``: the tree was not set up by a runner."""
 
 
-class BearingsBehaviour(py_trees.behaviour.Behaviour):
-    """A leaf behaviour with typed ports; subclasses implement ``initialise``/``update``."""
+class BearingsBehaviour(Declared, py_trees.behaviour.Behaviour):
+    """A leaf behaviour with typed ports; subclasses implement ``initialise``/``update``.
 
-    PARAMS: ClassVar[tuple[Param, ...]] = ()
-    READS: ClassVar[tuple[str, ...]] = ()
-    WRITES: ClassVar[tuple[str, ...]] = ()
-    KIND: ClassVar[str] = "action"  # or "condition"
+    Construct with the node's name and its ports as keyword arguments, exactly as a mission
+    writes them: literals, ``"{/ns/key}"`` references for inputs, keys for outputs::
 
-    def __init__(self, name: str | None = None, **params: Any) -> None:
+        Perceive(name="front eyes", camera="front", observation="{/perception/front}")
+    """
+
+    KIND: ClassVar[Kind] = "action"
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name or type(self).__name__)
-        self.params = bind_params(type(self).__name__, self.PARAMS, params)
+        self.inputs, self.outputs = bind_ports(type(self).__name__, self.PORTS, ports)
         self.bb = self.attach_blackboard_client(name=self.name)
-        refs = [value.key.split(".", 1)[0] for value in self.params.values() if isinstance(value, Ref)]
-        for key in dict.fromkeys([*self.READS, *refs]):
-            self.bb.register_key(key=key, access=Access.READ)
-        for key in self.WRITES:
+        for key in read_keys(self.PORTS, self.inputs):
+            if not self.bb.is_registered(key=key):
+                self.bb.register_key(key=key, access=Access.READ)
+        for key in self.outputs.values():
             self.bb.register_key(key=key, access=Access.WRITE)
         self._clock: Clock | None = None
+        self._output_types = {p.name: p.type for p in self.PORTS if isinstance(p, OutputPort)}
 
     # -- set-up ----------------------------------------------------------------------------
     def setup(self, **kwargs: Any) -> None:
@@ -54,48 +75,90 @@ class BearingsBehaviour(py_trees.behaviour.Behaviour):
         return self.clock.now()
 
     # -- ports -----------------------------------------------------------------------------
-    def param(self, name: str) -> Any:
-        """A parameter's value now: the literal, or the referenced blackboard value."""
-        value = self.params[name]
-        if isinstance(value, Ref):
-            return self.bb.get(value.key)
-        return value
+    def get_input(self, port: str, default: Any = _UNSET) -> Any:
+        """An input's value now: the literal, or the referenced blackboard value.
 
-    def read(self, key: str, default: Any = None) -> Any:
-        """A declared key's value, or ``default`` when nobody has written it yet."""
+        A reference nobody has written yet gives ``default`` (``KeyError`` without one).
+        """
+        value = self.inputs[port]
+        if not isinstance(value, Ref):
+            return value
         try:
-            return self.bb.get(key)
+            return self.bb.get(value.key)
         except KeyError:
+            if default is _UNSET:
+                raise KeyError(f"{self.name}: input {port!r} reads {value}, which is not set yet") from None
             return default
 
-    def write(self, key: str, value: Any) -> None:
-        self.bb.set(key, value, overwrite=True)
+    def set_output(self, port: str, value: Any) -> None:
+        """Write an output port's key; a value of the wrong type is a bug in the behaviour."""
+        expected = self._output_types[port]
+        if not matches_type(value, expected):
+            raise TypeError(f"{self.name}: output {port!r} is declared {type_name(expected)}, "
+                            f"got {type(value).__name__}")
+        self.bb.set(self.outputs[port], value, overwrite=True)
+
+    def output_key(self, port: str) -> str:
+        """The blackboard key an output port writes (after remapping)."""
+        return self.outputs[port]
 
 
-def bind_params(owner: str, declared: tuple[Param, ...], given: dict[str, Any]) -> dict[str, Any]:
-    """Check given parameters against the declaration and fill in defaults (programmatic use).
+def read_keys(declared: tuple[Port, ...], inputs: dict[str, Any]) -> list[str]:
+    """The blackboard entries bound inputs read: references, and literal ``Key`` inputs (a key to watch)."""
+    keys = []
+    for port in declared:
+        value = inputs.get(port.name)
+        if isinstance(value, Ref):
+            keys.append(value.base)
+        elif isinstance(port, InputPort) and port.type is Key and isinstance(value, str):
+            keys.append(value.split(".", 1)[0])
+    return list(dict.fromkeys(keys))
 
-    Raises TypeError/ValueError with the offending parameter named; the mission loader reports the
-    same problems with file positions before it ever constructs a node.
+
+def bind_ports(owner: str, declared: tuple[Port, ...], given: dict[str, Any]) -> tuple[dict[str, Any], dict[str, str]]:
+    """Check ports given in code against the declaration; (inputs, output keys) with defaults filled.
+
+    Raises TypeError/ValueError naming the port; the mission loader reports the same problems
+    with file positions before it ever constructs a node.
     """
     by_name = {p.name: p for p in declared}
     unknown = sorted(set(given) - set(by_name))
     if unknown:
-        raise TypeError(f"{owner}: unknown parameter(s) {', '.join(unknown)}")
-    bound: dict[str, Any] = {}
-    for param in declared:
-        if param.name not in given:
-            if param.default is REQUIRED:
-                raise TypeError(f"{owner}: missing required parameter {param.name!r}")
-            bound[param.name] = param.default
-            continue
-        value = given[param.name]
-        ref = value if isinstance(value, Ref) else parse_ref(value)
-        if ref is not None:
-            bound[param.name] = ref
-            continue
-        value, error = check_value(param, value)
-        if error:
-            raise ValueError(f"{owner}.{param.name} {error}")
-        bound[param.name] = value
-    return bound
+        raise TypeError(f"{owner}: unknown port(s) {', '.join(unknown)} (it has: {', '.join(by_name) or 'none'})")
+    inputs: dict[str, Any] = {}
+    outputs: dict[str, str] = {}
+    for port in declared:
+        value = given.get(port.name, _UNSET)
+        if isinstance(port, OutputPort):
+            outputs[port.name] = _output_key(owner, port, value)
+        else:
+            inputs[port.name] = _input_value(owner, port, value)
+    return inputs, outputs
+
+
+def _output_key(owner: str, port: OutputPort, value: Any) -> str:
+    if value is _UNSET:
+        return port.key
+    ref = parse_ref(value) or (Ref(value) if isinstance(value, str) else None)
+    problem = key_problem(ref.key, attributes=False) if ref else "expects a blackboard key"
+    if problem or ref is None:
+        raise ValueError(f"{owner}.{port.name}: {problem}")
+    return ref.key
+
+
+def _input_value(owner: str, port: InputPort, value: Any) -> Any:
+    if value is _UNSET:
+        if port.default is REQUIRED:
+            raise TypeError(f"{owner}: missing required input {port.name!r}")
+        value = port.default
+    if value is None and port.default is None:
+        return None  # an optional input left unset
+    ref = parse_ref(value)
+    if ref is not None:
+        if port.literal_only:
+            raise ValueError(f"{owner}.{port.name} takes a literal value, not a blackboard reference")
+        return ref
+    value, problem = check_literal(port, value)
+    if problem:
+        raise ValueError(f"{owner}.{port.name} {problem}")
+    return value

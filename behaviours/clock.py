@@ -2,11 +2,11 @@
 
 Nothing below ``missions/`` reads ``time.monotonic()`` or sleeps; time-based behaviours call
 ``clock.now()`` on the clock they received at setup, so a 5 s timeout lasts 5 simulated seconds.
+The wall clock lives in :mod:`missions.clocks`.
 """
 
 from __future__ import annotations
 
-import time
 from typing import Protocol, runtime_checkable
 
 
@@ -17,11 +17,30 @@ class Clock(Protocol):
     def now(self) -> float: ...
 
 
+@runtime_checkable
+class TickClock(Clock, Protocol):
+    """The clock a runner ticks a tree on: it also knows how to get to the next tick.
+
+    On a robot that means waiting for wall time (``missions.clocks.WallClock``); in the
+    simulator it means stepping the world (``Simulation.clock()``): the simulator is a driver
+    that the clock steps. ``timeline`` names the time axis in recordings.
+    """
+
+    timeline: str
+
+    def next_tick(self, period: float) -> None:
+        """Move to the start of the next tick, ``period`` seconds after the previous one."""
+
+
 class ManualClock:
-    """A clock that only moves when told: the simulator's time and the unit-test clock."""
+    """A clock that only moves when told: the unit-test clock, and a runner's clock without a world."""
+
+    timeline = "sim_time"
 
     def __init__(self, start: float = 0.0) -> None:
         self._now = float(start)
+        self._origin = float(start)
+        self._ticks = 0
 
     def now(self) -> float:
         return self._now
@@ -39,12 +58,7 @@ class ManualClock:
             raise ValueError("time cannot go backwards")
         self._now = float(seconds)
 
-
-class MonotonicClock:
-    """Wall time on a robot: ``time.monotonic()`` relative to the clock's creation."""
-
-    def __init__(self) -> None:
-        self._start = time.monotonic()
-
-    def now(self) -> float:
-        return time.monotonic() - self._start
+    def next_tick(self, period: float) -> None:
+        """Jump to the next tick: ``start + ticks * period`` (no drift from summing the period)."""
+        self._ticks += 1
+        self._now = max(self._now, self._origin + self._ticks * period)

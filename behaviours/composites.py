@@ -7,14 +7,22 @@ from collections.abc import Iterator
 import py_trees
 from py_trees.common import Status
 
+from behaviours.ports import InputPort
+from behaviours.registry import Declared, register
 
-class RecoveryNode(py_trees.composites.Composite):
-    """Tick the first child; when it fails, tick the second (the recovery) and try again.
+
+@register
+class RecoveryNode(Declared, py_trees.composites.Composite):
+    """Nav2 recovery: tick the task; on failure tick the recovery and retry the task.
 
     Nav2 semantics: SUCCESS when the first child succeeds; when it fails and fewer than
     ``number_of_retries`` recoveries have run, tick the recovery: its SUCCESS starts the first
     child afresh, its FAILURE fails the node. FAILURE once the retries are used up.
     """
+
+    KIND = "composite"
+    PORTS = (InputPort("number_of_retries", int, 1, minimum=0, literal_only=True, doc="recoveries to try"),)
+    CHILDREN = (2, 2)
 
     def __init__(
         self, name: str, children: list[py_trees.behaviour.Behaviour], number_of_retries: int = 1

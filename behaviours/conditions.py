@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Any
-
-from py_trees.common import Access, Status
+from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
 from behaviours.comparison import compare
-from behaviours.ports import COMPARISONS, Param
+from behaviours.decorators import GUARD_PORTS
+from behaviours.ports import InputPort, Ref
 from behaviours.registry import register
 
 
@@ -17,18 +16,10 @@ class CheckBlackboard(BearingsBehaviour):
     """SUCCESS when ``key op value`` holds on the blackboard, FAILURE otherwise (or when unset)."""
 
     KIND = "condition"
-    PARAMS = (
-        Param("key", "key", doc="absolute key, optionally with an attribute: /robot/odometry.x", refs=False),
-        Param("op", "str", "==", doc="comparison", choices=COMPARISONS, refs=False),
-        Param("value", "any", doc="the value to compare with", refs=False),
-    )
-
-    def __init__(self, name: str | None = None, **params: Any) -> None:
-        super().__init__(name=name, **params)
-        self.bb.register_key(key=self.params["key"].split(".", 1)[0], access=Access.READ)
+    PORTS = GUARD_PORTS
 
     def update(self) -> Status:
-        key, op, value = self.params["key"], self.params["op"], self.params["value"]
+        key, op, value = self.inputs["key"], self.inputs["op"], self.inputs["value"]
         try:
             current = self.bb.get(key)
         except KeyError:
@@ -44,7 +35,7 @@ class IsStalled(BearingsBehaviour):
     """SUCCESS while the base reports a stalled wheel (a collision), FAILURE otherwise."""
 
     KIND = "condition"
-    READS = ("/robot/stalled",)
+    PORTS = (InputPort("stalled", bool, Ref("/robot/stalled"), doc="the base's stall flag"),)
 
     def update(self) -> Status:
-        return Status.SUCCESS if self.read("/robot/stalled", False) else Status.FAILURE
+        return Status.SUCCESS if self.get_input("stalled", False) else Status.FAILURE

@@ -15,10 +15,15 @@ from py_trees.common import Status
 from behaviours.base import NotSetUp
 from behaviours.clock import Clock
 from behaviours.comparison import compare
+from behaviours.ports import COMPARISONS, InputPort, Key
+from behaviours.registry import Declared, register
 
 
-class _ClockedDecorator(py_trees.decorators.Decorator):
+class _ClockedDecorator(Declared, py_trees.decorators.Decorator):
     """A decorator that receives the tree's clock at setup."""
+
+    KIND = "decorator"
+    CHILDREN = (1, 1)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour) -> None:
         super().__init__(name=name, child=child)
@@ -45,12 +50,15 @@ class _ClockedDecorator(py_trees.decorators.Decorator):
         return self._clock.now()
 
 
+@register
 class Timeout(_ClockedDecorator):
-    """FAILURE (and the child halted) once the child has run ``duration`` seconds of tree time.
+    """FAILURE, halting the child, when it runs longer than duration (tree clock).
 
     The deadline is checked before the child is ticked, as BehaviorTree.CPP does, so a child is
     never ticked after its time is up.
     """
+
+    PORTS = (InputPort("duration", float, unit="s", minimum=0.0, literal_only=True, doc="time limit in tree time"),)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, duration: float) -> None:
         super().__init__(name=name, child=child)
@@ -72,12 +80,15 @@ class Timeout(_ClockedDecorator):
         yield from self._tick_child()
 
 
+@register
 class RateController(_ClockedDecorator):
-    """Tick the child at most ``hz`` times per second of tree time; RUNNING in between.
+    """Tick the child at most hz times per second (tree clock); RUNNING in between.
 
     A child that finishes passes its status up at once; the next tick after that starts it again
     only when the period has elapsed (Nav2's RateController throttles the same way).
     """
+
+    PORTS = (InputPort("hz", float, unit="Hz", minimum=1e-6, literal_only=True, doc="highest tick rate of the child"),)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, hz: float) -> None:
         super().__init__(name=name, child=child)
@@ -96,19 +107,35 @@ class RateController(_ClockedDecorator):
         yield from self._tick_child()
 
 
-def make_guard(name: str, child: py_trees.behaviour.Behaviour, key: str, op: str, value: Any):
-    """A py_trees ``EternalGuard``: tick the child only while ``key op value`` holds, else FAILURE.
+GUARD_PORTS = (
+    InputPort("key", Key, literal_only=True, doc="blackboard key (absolute), optionally with an attribute: "
+              "/robot/odometry.x"),
+    InputPort("op", str, "==", choices=COMPARISONS, literal_only=True, doc="comparison"),
+    InputPort("value", object, literal_only=True, doc="the value to compare with"),
+)
 
-    An unset key counts as the condition not holding.
+
+@register
+class Guard(Declared, py_trees.decorators.EternalGuard):
+    """Tick the child only while the blackboard condition holds; FAILURE otherwise.
+
+    A py_trees ``EternalGuard`` on ``key op value``; an unset key counts as the condition not
+    holding.
     """
 
-    def condition(blackboard: py_trees.blackboard.Client) -> bool:
-        try:
-            current = blackboard.get(key)
-        except KeyError:
-            return False
-        return compare(current, op, value)
+    KIND = "decorator"
+    PORTS = GUARD_PORTS
+    BTCPP = "Precondition"
+    CHILDREN = (1, 1)
 
-    return py_trees.decorators.EternalGuard(
-        name=name, child=child, condition=condition, blackboard_keys=[key.split(".", 1)[0]]
-    )
+    def __init__(self, name: str, child: py_trees.behaviour.Behaviour, key: str, op: str = "==", value: Any = None
+                 ) -> None:
+        def condition(blackboard: py_trees.blackboard.Client) -> bool:
+            try:
+                current = blackboard.get(key)
+            except KeyError:
+                return False
+            return compare(current, op, value)
+
+        super().__init__(name=name, child=child, condition=condition, blackboard_keys=[key.split(".", 1)[0]])
+        self.key, self.op, self.value = key, op, value

@@ -1,9 +1,10 @@
 """Basic motion on odometry: drive a distance, rotate by an angle, drive to a point, stop.
 
-Each behaviour writes a :class:`~drivers.interfaces.VelocityCommand` to ``/robot/command`` every
-tick it runs; the runner clears the command before each tick, so a finished or halted behaviour
-leaves the robot commanded to rest. Speeds ramp down as ``sqrt(2 a d)`` near the end so the base
-stops on target within its deceleration limit instead of overshooting.
+Each behaviour writes a :class:`~drivers.interfaces.VelocityCommand` to its ``command`` output
+(``/robot/command`` unless remapped) every tick it runs; the runner clears the command before
+each tick, so a finished or halted behaviour leaves the robot commanded to rest. Speeds ramp
+down as ``sqrt(2 a d)`` near the end so the base stops on target within its deceleration limit
+instead of overshooting.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import math
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.ports import Param
+from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from drivers.interfaces import STOP, VelocityCommand
 from perception.geometry import Pose2D, wrap_angle
@@ -31,18 +32,24 @@ def ramp(remaining: float, top: float, decel: float, floor: float) -> float:
     return math.copysign(max(speed, floor), remaining)
 
 
+ODOMETRY = InputPort("odometry", Pose2D, Ref("/robot/odometry"), doc="the base's pose in the odometry frame")
+STALLED = InputPort("stalled", bool, Ref("/robot/stalled"), doc="a wheel is stalled: stop and fail")
+COMMAND = OutputPort("command", VelocityCommand, "/robot/command", unit="m/s, rad/s",
+                     doc="the velocity for this tick (the runner sends it to the base)")
+MOTION_PORTS = (ODOMETRY, STALLED, COMMAND)
+
+
 class _OdometryMotion(BearingsBehaviour):
-    READS = ("/robot/odometry", "/robot/stalled")
-    WRITES = ("/robot/command",)
+    PORTS = MOTION_PORTS
 
     def odometry(self) -> Pose2D | None:
-        return self.read("/robot/odometry")
+        return self.get_input("odometry", None)
 
     def command(self, v: float, w: float) -> None:
-        self.write("/robot/command", VelocityCommand(v, w))
+        self.set_output("command", VelocityCommand(v, w))
 
     def blocked(self) -> bool:
-        if self.read("/robot/stalled", False):
+        if self.get_input("stalled", False):
             self.command(0.0, 0.0)
             self.feedback_message = "stalled"
             return True
@@ -63,17 +70,18 @@ class _OdometryMotion(BearingsBehaviour):
 
     def terminate(self, new_status: Status) -> None:
         if new_status != Status.RUNNING:
-            self.write("/robot/command", STOP)
+            self.set_output("command", STOP)
 
 
 @register
 class Drive(_OdometryMotion):
     """Drive straight ``distance`` metres (negative: backwards), holding the starting heading."""
 
-    PARAMS = (
-        Param("distance", "float", unit="m", doc="signed distance along the starting heading"),
-        Param("speed", "float", 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2),
-        Param("tolerance", "float", 0.01, unit="m", doc="close enough", minimum=0.001),
+    PORTS = (
+        InputPort("distance", float, unit="m", doc="signed distance along the starting heading"),
+        InputPort("speed", float, 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2),
+        InputPort("tolerance", float, 0.01, unit="m", doc="close enough", minimum=0.001),
+        *MOTION_PORTS,
     )
 
     def initialise(self) -> None:
@@ -84,11 +92,11 @@ class Drive(_OdometryMotion):
             self._start = pose
         start = self._start
         travelled = (pose.x - start.x) * math.cos(start.theta) + (pose.y - start.y) * math.sin(start.theta)
-        remaining = float(self.param("distance")) - travelled
-        if abs(remaining) <= float(self.param("tolerance")):
+        remaining = float(self.get_input("distance")) - travelled
+        if abs(remaining) <= float(self.get_input("tolerance")):
             self.command(0.0, 0.0)
             return Status.SUCCESS
-        v = ramp(remaining, float(self.param("speed")), LINEAR_DECEL, MIN_SPEED)
+        v = ramp(remaining, float(self.get_input("speed")), LINEAR_DECEL, MIN_SPEED)
         w = -HEADING_GAIN * wrap_angle(pose.theta - start.theta)
         self.command(v, w)
         self.feedback_message = f"{remaining:+.2f} m to go"
@@ -99,10 +107,11 @@ class Drive(_OdometryMotion):
 class Rotate(_OdometryMotion):
     """Turn on the spot by ``angle`` degrees (positive: counter-clockwise)."""
 
-    PARAMS = (
-        Param("angle", "float", unit="deg", doc="signed angle to turn"),
-        Param("speed", "float", 45.0, unit="deg/s", doc="top turn rate", minimum=1.0, maximum=300.0),
-        Param("tolerance", "float", 1.0, unit="deg", doc="close enough", minimum=0.05),
+    PORTS = (
+        InputPort("angle", float, unit="deg", doc="signed angle to turn"),
+        InputPort("speed", float, 45.0, unit="deg/s", doc="top turn rate", minimum=1.0, maximum=300.0),
+        InputPort("tolerance", float, 1.0, unit="deg", doc="close enough", minimum=0.05),
+        *MOTION_PORTS,
     )
 
     def initialise(self) -> None:
@@ -113,11 +122,11 @@ class Rotate(_OdometryMotion):
         if self._last is not None:
             self._turned += wrap_angle(pose.theta - self._last)  # unwrapped: angles beyond 180 deg work
         self._last = pose.theta
-        remaining = math.radians(float(self.param("angle"))) - self._turned
-        if abs(remaining) <= math.radians(float(self.param("tolerance"))):
+        remaining = math.radians(float(self.get_input("angle"))) - self._turned
+        if abs(remaining) <= math.radians(float(self.get_input("tolerance"))):
             self.command(0.0, 0.0)
             return Status.SUCCESS
-        w = ramp(remaining, math.radians(float(self.param("speed"))), ANGULAR_DECEL, MIN_TURN)
+        w = ramp(remaining, math.radians(float(self.get_input("speed"))), ANGULAR_DECEL, MIN_TURN)
         self.command(0.0, w)
         self.feedback_message = f"{math.degrees(remaining):+.1f} deg to go"
         return Status.RUNNING
@@ -127,23 +136,24 @@ class Rotate(_OdometryMotion):
 class DriveTo(_OdometryMotion):
     """Drive to the point (x, y) of the odometry frame: turn towards it, then drive while steering."""
 
-    PARAMS = (
-        Param("x", "float", unit="m", doc="goal x in the odometry frame"),
-        Param("y", "float", unit="m", doc="goal y in the odometry frame"),
-        Param("speed", "float", 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2),
-        Param("tolerance", "float", 0.05, unit="m", doc="goal radius", minimum=0.005),
+    PORTS = (
+        InputPort("x", float, unit="m", doc="goal x in the odometry frame"),
+        InputPort("y", float, unit="m", doc="goal y in the odometry frame"),
+        InputPort("speed", float, 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2),
+        InputPort("tolerance", float, 0.05, unit="m", doc="goal radius", minimum=0.005),
+        *MOTION_PORTS,
     )
     TURN_IN_PLACE = math.radians(30.0)  # heading error above which the robot turns before driving
 
     def step(self, pose: Pose2D) -> Status:
-        dx, dy = float(self.param("x")) - pose.x, float(self.param("y")) - pose.y
+        dx, dy = float(self.get_input("x")) - pose.x, float(self.get_input("y")) - pose.y
         distance = math.hypot(dx, dy)
-        if distance <= float(self.param("tolerance")):
+        if distance <= float(self.get_input("tolerance")):
             self.command(0.0, 0.0)
             return Status.SUCCESS
         error = wrap_angle(math.atan2(dy, dx) - pose.theta)
         w = ramp(error, math.radians(60.0), ANGULAR_DECEL, 0.0) if error else 0.0
-        v = 0.0 if abs(error) > self.TURN_IN_PLACE else ramp(distance, float(self.param("speed")),
+        v = 0.0 if abs(error) > self.TURN_IN_PLACE else ramp(distance, float(self.get_input("speed")),
                                                               LINEAR_DECEL, MIN_SPEED) * math.cos(error)
         self.command(v, w)
         self.feedback_message = f"{distance:.2f} m to go"
@@ -153,6 +163,8 @@ class DriveTo(_OdometryMotion):
 @register
 class Stop(_OdometryMotion):
     """Command the base to rest; SUCCESS at once (with or without odometry, stalled or not)."""
+
+    PORTS = (COMMAND,)
 
     def update(self) -> Status:
         self.command(0.0, 0.0)

@@ -1,22 +1,43 @@
-"""Typed ports: the parameters a node type declares, and references to blackboard keys.
+"""Typed ports: what a node type reads and writes, declared once, checked before anything ticks.
 
-A parameter value in a mission is either a literal (checked against the declared type at load
-time) or a reference ``{/ns/key}`` read from the blackboard when the node ticks.
+As in BehaviorTree.CPP, every node type declares its ports, here with Python types:
+
+- an :class:`InputPort` takes a literal (checked against the port's type, unit and range at load
+  time) or a reference ``{/ns/key}`` to a blackboard entry read when the node ticks; its default
+  may itself be a reference (``Drive`` reads ``{/robot/odometry}`` unless a mission says
+  otherwise);
+- an :class:`OutputPort` names the blackboard key the node writes; a mission may remap it per
+  node (two ``Perceive`` nodes on two cameras write two observation keys).
+
+The mission loader checks the whole data flow with these declarations (see
+:mod:`missions.dataflow`); the BehaviorTree.CPP export writes them as ``input_port`` and
+``output_port`` in its ``TreeNodesModel``.
 """
 
 from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import Any
+import types
+import typing
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, NewType, Union
 
-from behaviours.keys import key_spec
+from maps.located import describe_value
+
+Key = NewType("Key", str)
+"""A blackboard key given as a literal (``CheckBlackboard.key``): the node reads that key."""
 
 REF_PATTERN = re.compile(r"^\{(/[A-Za-z_][\w/]*(?:\.[A-Za-z_]\w*)*)\}$")
+KEY_PATTERN = re.compile(r"^/[A-Za-z_][\w/]*(?:\.[A-Za-z_]\w*)*$")
+NAMESPACES = ("/robot", "/ptu", "/perception", "/map", "/mission")
 COMPARISONS = ("==", "!=", "<", "<=", ">", ">=")
-TYPES = ("float", "int", "bool", "str", "key", "list[float]", "any")
+
+# The types a mission can name (input declarations, ``bearings schema``), by their YAML names.
+TYPE_NAMES: dict[str, Any] = {
+    "float": float, "int": int, "bool": bool, "str": str, "key": Key, "list[float]": list[float], "any": Any,
+}  # fmt: skip
 
 
 class _Missing:
@@ -29,36 +50,41 @@ REQUIRED: Any = _Missing()
 
 @dataclass(frozen=True, slots=True)
 class Ref:
-    """A reference to a blackboard key (optionally an attribute of its value, ``/robot/odometry.x``)."""
+    """A reference to a blackboard key, optionally to an attribute of its value (``/robot/odometry.x``)."""
 
     key: str
+
+    @property
+    def base(self) -> str:
+        """The blackboard entry itself, without the attribute path."""
+        return self.key.split(".", 1)[0]
+
+    @property
+    def attributes(self) -> tuple[str, ...]:
+        return tuple(self.key.split(".")[1:])
 
     def __str__(self) -> str:
         return "{" + self.key + "}"
 
 
 @dataclass(frozen=True, slots=True)
-class Param:
-    """One declared parameter of a node type.
+class InputPort:
+    """An input of a node type: a literal or a ``{/ns/key}`` reference of type ``type``.
 
-    ``type`` is one of :data:`TYPES`; ``unit`` is the unit the mission writes the value in;
-    ``choices`` restricts a ``str`` parameter; ``minimum``/``maximum`` bound numbers.
+    ``unit`` is the unit a mission writes the value in; ``choices`` restrict a ``str``;
+    ``minimum``/``maximum`` bound numbers; ``literal_only`` ports configure the node and cannot
+    change while it runs (they take no reference).
     """
 
     name: str
-    type: str
+    type: Any
     default: Any = REQUIRED
     unit: str = ""
     doc: str = ""
     choices: tuple[str, ...] = ()
     minimum: float | None = None
     maximum: float | None = None
-    refs: bool = True  # may the value be a blackboard reference?
-    extra: dict = field(default_factory=dict, compare=False)
-
-    def __post_init__(self) -> None:
-        if self.type not in TYPES:
-            raise ValueError(f"parameter {self.name!r}: unknown type {self.type!r}")
+    literal_only: bool = False
 
     @property
     def required(self) -> bool:
@@ -66,94 +92,219 @@ class Param:
 
     def describe(self) -> str:
         unit = f" [{self.unit}]" if self.unit else ""
-        default = "required" if self.required else f"default {self.default!r}"
-        return f"{self.name}: {self.type}{unit}, {default}. {self.doc}".strip()
+        default = "required" if self.required else f"default {format_literal(self.default)}"
+        return f"{self.name}: {type_name(self.type)}{unit}, {default}. {self.doc}".strip()
 
 
+@dataclass(frozen=True, slots=True)
+class OutputPort:
+    """An output of a node type: it writes values of ``type`` to blackboard key ``key`` (remappable)."""
+
+    name: str
+    type: Any
+    key: str
+    doc: str = ""
+    unit: str = ""
+
+    def describe(self) -> str:
+        return f"{self.name} -> {{{self.key}}}: {type_name(self.type)}. {self.doc}".strip()
+
+
+Port = InputPort | OutputPort
+
+
+# -- type names and compatibility ------------------------------------------------------------------
+def type_name(tp: Any) -> str:
+    """The name a type is written with in missions, schemas and the BT.CPP export."""
+    for name, known in TYPE_NAMES.items():
+        if tp is known or tp == known:
+            return name
+    if _is_union(tp):
+        return " | ".join(type_name(t) for t in typing.get_args(tp))
+    if tp is object:
+        return "any"
+    return getattr(tp, "__name__", str(tp))
+
+
+def _is_union(tp: Any) -> bool:
+    return typing.get_origin(tp) in (Union, types.UnionType)
+
+
+def _plain(tp: Any) -> Any:
+    """``Key`` is text at run time; ``object`` means any."""
+    if tp is Key:
+        return str
+    return Any if tp is object else tp
+
+
+def assignable(source: Any, target: Any) -> bool:
+    """Can a value declared as ``source`` feed a port declared as ``target``?
+
+    ``Any`` on either side is accepted (checked when the value arrives); ``int`` feeds ``float``;
+    classes follow subclassing; unions must fit member by member; generic aliases must be equal.
+    """
+    source, target = _plain(source), _plain(target)
+    if source is Any or target is Any or source == target:
+        return True
+    if _is_union(source):
+        return all(assignable(member, target) for member in typing.get_args(source))
+    if _is_union(target):
+        return any(assignable(source, member) for member in typing.get_args(target))
+    if target is float and source is int:
+        return True
+    if isinstance(source, type) and isinstance(target, type):
+        return issubclass(source, target) and not (source is bool and target is not bool)
+    return False
+
+
+def attribute_type(owner: Any, attribute: str) -> Any:
+    """The declared type of ``owner.attribute`` (a dataclass field or a typed property).
+
+    ``Any`` when ``owner`` is not a class with type hints (nothing to check); raises
+    ``AttributeError`` when the class declares no such attribute.
+    """
+    owner = _plain(owner)
+    if not isinstance(owner, type):
+        return Any
+    try:
+        hints = typing.get_type_hints(owner)
+    except Exception:  # noqa: BLE001 - unresolvable annotations: do not check
+        return Any
+    if attribute in hints:
+        return hints[attribute]
+    member = getattr(owner, attribute, None)
+    if isinstance(member, property) and member.fget is not None:
+        return typing.get_type_hints(member.fget).get("return", Any)
+    if member is None:
+        raise AttributeError(f"{owner.__name__} has no attribute {attribute!r}")
+    return Any
+
+
+def matches_type(value: Any, tp: Any) -> bool:
+    """Does a run-time value fit a declared type (as far as ``isinstance`` can tell)?"""
+    tp = _plain(tp)
+    if tp is Any or value is None:
+        return True
+    if _is_union(tp):
+        return any(matches_type(value, member) for member in typing.get_args(tp))
+    origin = typing.get_origin(tp)
+    if origin is not None:
+        return isinstance(value, origin)
+    if tp is float:
+        return isinstance(value, (int, float)) and not isinstance(value, bool)
+    return isinstance(value, tp) if isinstance(tp, type) else True
+
+
+# -- references ------------------------------------------------------------------------------------
 def parse_ref(value: Any) -> Ref | None:
     """The reference a YAML value spells, or None for a literal.
 
     ``"{/map/goal}"`` (a string) and ``{/map/goal}`` (YAML flow mapping with one null entry) both
     mean the key ``/map/goal``.
     """
+    if isinstance(value, Ref):
+        return value
     if isinstance(value, str):
         match = REF_PATTERN.match(value.strip())
         return Ref(match.group(1)) if match else None
     if isinstance(value, dict) and len(value) == 1:
-        (key, val), = value.items()
+        ((key, val),) = value.items()
         if val is None and isinstance(key, str):
             return parse_ref("{" + key + "}")
     return None
 
 
-def check_value(param: Param, value: Any) -> tuple[Any, str | None]:
-    """Coerce a literal to the parameter's type; returns (value, error message or None)."""
-    kind = param.type
-    if kind == "any":
-        return value, None
-    if kind == "float":
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            return value, f"expects a number{_unit(param)}, got {describe_value(value)}"
-        value = float(value)
-        if not math.isfinite(value):
-            return value, f"expects a finite number, got {value}"
-    elif kind == "int":
-        if isinstance(value, bool) or not isinstance(value, int):
-            return value, f"expects a whole number, got {describe_value(value)}"
-    elif kind == "bool":
-        if not isinstance(value, bool):
-            return value, f"expects true or false, got {describe_value(value)}"
-    elif kind in ("str", "key"):
-        if not isinstance(value, str):
-            return value, f"expects text, got {describe_value(value)}"
-        if kind == "key":
-            if key_spec(value) is None:
-                return value, f"unknown blackboard key {value!r}"
-        elif param.choices and value not in param.choices:
-            return value, f"expects one of {', '.join(param.choices)}, got {value!r}"
-    elif kind == "list[float]":
-        if not isinstance(value, Sequence) or isinstance(value, str):
-            return value, f"expects a list of numbers, got {describe_value(value)}"
-        items = []
-        for item in value:
-            if isinstance(item, bool) or not isinstance(item, (int, float)):
-                return value, f"expects a list of numbers, found {describe_value(item)}"
-            items.append(float(item))
-        value = items
-    if kind in ("float", "int"):
-        if param.minimum is not None and value < param.minimum:
-            return value, f"must be >= {param.minimum:g}{_unit(param)}, got {value:g}"
-        if param.maximum is not None and value > param.maximum:
-            return value, f"must be <= {param.maximum:g}{_unit(param)}, got {value:g}"
-    return value, None
-
-
-def check_ref(param: Param, ref: Ref) -> str | None:
-    """Why a reference cannot feed this parameter, or None if it can."""
-    if not param.refs:
-        return "takes a literal value, not a blackboard reference"
-    spec = key_spec(ref.key)
-    if spec is None:
-        return f"refers to unknown blackboard key {ref.key!r}"
-    if "." in ref.key or spec.type is object or param.type == "any":
-        return None
-    wanted = {"float": (float, int), "int": (int,), "bool": (bool,), "str": (str,), "key": (str,),
-              "list[float]": (list, tuple)}[param.type]
-    if not (isinstance(spec.type, type) and issubclass(spec.type, wanted)):
-        return f"refers to {ref.key} which holds {getattr(spec.type, '__name__', spec.type)}, not {param.type}"
+def key_problem(key: str, *, attributes: bool = True) -> str | None:
+    """Why ``key`` is not a usable blackboard key, or None."""
+    if not KEY_PATTERN.match(key) or (not attributes and "." in key):
+        return f"{key!r} is not a blackboard key like /map/goal" + ("" if attributes else " (no attribute path)")
+    namespace = "/" + key.split("/")[1]
+    if namespace not in NAMESPACES or key.count("/") < 2:
+        return f"{key!r} is outside the blackboard namespaces {', '.join(NAMESPACES)}"
     return None
 
 
-def _unit(param: Param) -> str:
-    return f" in {param.unit}" if param.unit else ""
+# -- literals --------------------------------------------------------------------------------------
+Checker = Callable[[InputPort, Any], tuple[Any, str | None]]
 
 
-def describe_value(value: Any) -> str:
-    """A value as error messages name it: 'a mapping', 'a list', 'nothing (null)' or its repr."""
-    if isinstance(value, dict):
-        return "a mapping"
+def _number(port: InputPort, value: Any) -> tuple[Any, str | None]:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return value, f"expects a number{_in_unit(port)}, got {describe_value(value)}"
+    if not math.isfinite(value):
+        return value, f"expects a finite number, got {value}"
+    return _bounded(port, float(value))
+
+
+def _integer(port: InputPort, value: Any) -> tuple[Any, str | None]:
+    if isinstance(value, bool) or not isinstance(value, int):
+        return value, f"expects a whole number, got {describe_value(value)}"
+    return _bounded(port, value)
+
+
+def _boolean(port: InputPort, value: Any) -> tuple[Any, str | None]:
+    return value, None if isinstance(value, bool) else f"expects true or false, got {describe_value(value)}"
+
+
+def _text(port: InputPort, value: Any) -> tuple[Any, str | None]:
+    if not isinstance(value, str):
+        return value, f"expects text, got {describe_value(value)}"
+    if port.choices and value not in port.choices:
+        return value, f"expects one of {', '.join(port.choices)}, got {value!r}"
+    return value, None
+
+
+def _key(port: InputPort, value: Any) -> tuple[Any, str | None]:
+    if not isinstance(value, str):
+        return value, f"expects a blackboard key, got {describe_value(value)}"
+    return value, key_problem(value)
+
+
+def _numbers(port: InputPort, value: Any) -> tuple[Any, str | None]:
+    if not isinstance(value, Sequence) or isinstance(value, str):
+        return value, f"expects a list of numbers, got {describe_value(value)}"
+    bad = [item for item in value if isinstance(item, bool) or not isinstance(item, (int, float))
+           or not math.isfinite(item)]
+    if bad:
+        return value, f"expects a list of finite numbers, found {describe_value(bad[0])}"
+    return [float(item) for item in value], None
+
+
+_CHECKERS: dict[Any, Checker] = {float: _number, int: _integer, bool: _boolean, str: _text, Key: _key,
+                                 list[float]: _numbers}
+
+
+def check_literal(port: InputPort, value: Any) -> tuple[Any, str | None]:
+    """Coerce a literal to the port's type; returns (value, error message or None)."""
+    if port.type is Any or port.type is object:
+        return value, None
+    checker = _CHECKERS.get(port.type)
+    if checker is None:
+        return value, (f"takes a {type_name(port.type)} from the blackboard: write a reference like "
+                       "{/ns/key}, not a literal")
+    return checker(port, value)
+
+
+def _bounded(port: InputPort, value: float) -> tuple[Any, str | None]:
+    if port.minimum is not None and value < port.minimum:
+        return value, f"must be >= {port.minimum:g}{_in_unit(port)}, got {value:g}"
+    if port.maximum is not None and value > port.maximum:
+        return value, f"must be <= {port.maximum:g}{_in_unit(port)}, got {value:g}"
+    return value, None
+
+
+def _in_unit(port: InputPort) -> str:
+    return f" in {port.unit}" if port.unit else ""
+
+
+def format_literal(value: Any) -> str:
+    """A literal or reference as missions and the BT.CPP export write it."""
+    if isinstance(value, Ref):
+        return str(value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:g}"
     if isinstance(value, list):
-        return "a list"
-    if value is None:
-        return "nothing (null)"
-    return repr(value)
+        return "[" + ", ".join(format_literal(v) for v in value) + "]"
+    return str(value)

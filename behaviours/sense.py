@@ -1,8 +1,10 @@
 """The data-gathering branch: driver readings onto the blackboard, once per tick.
 
 These are the only behaviours that touch a driver, and only through the interfaces of the
-:class:`~drivers.interfaces.Robot` handed to the tree at setup (``setup(robot=...)``). They are
-the single writers of the ``sense`` keys of :mod:`behaviours.keys`.
+:class:`~drivers.interfaces.Robot` handed to the tree at setup (``setup(robot=...)``). The
+runner puts them first in every tree (:data:`SENSE_NODES`); they are not in the registry, so a
+mission cannot add a second writer of the keys they own (the loader checks sensed keys keep a
+single writer).
 """
 
 from __future__ import annotations
@@ -12,8 +14,10 @@ from typing import Any
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour, NotSetUp
-from behaviours.registry import register
-from drivers.interfaces import Robot
+from behaviours.ports import OutputPort
+from drivers.interfaces import PanTiltState, Robot
+from perception.frame import Frame, LandmarkBearings
+from perception.geometry import Pose2D
 
 
 class _Sensor(BearingsBehaviour):
@@ -28,32 +32,32 @@ class _Sensor(BearingsBehaviour):
         return self._robot
 
 
-@register
 class ReadOdometry(_Sensor):
     """Copy the base's odometry and stall flag to ``/robot``."""
 
-    WRITES = ("/robot/odometry", "/robot/stalled")
+    PORTS = (
+        OutputPort("odometry", Pose2D, "/robot/odometry", doc="odometry pose of the base (drifts)"),
+        OutputPort("stalled", bool, "/robot/stalled", doc="a wheel is stalled (collision)"),
+    )
 
     def update(self) -> Status:
         base = self.robot.base
-        self.write("/robot/odometry", base.odometry())
-        self.write("/robot/stalled", bool(base.stalled()))
+        self.set_output("odometry", base.odometry())
+        self.set_output("stalled", bool(base.stalled()))
         return Status.SUCCESS
 
 
-@register
 class ReadPanTilt(_Sensor):
     """Copy the pan-tilt unit's state to ``/ptu/state`` (SUCCESS without doing anything if none)."""
 
-    WRITES = ("/ptu/state",)
+    PORTS = (OutputPort("state", PanTiltState, "/ptu/state", doc="pan/tilt position and motion"),)
 
     def update(self) -> Status:
         if self.robot.ptu is not None:
-            self.write("/ptu/state", self.robot.ptu.state())
+            self.set_output("state", self.robot.ptu.state())
         return Status.SUCCESS
 
 
-@register
 class GrabFrames(_Sensor):
     """Grab one frame per camera into ``/perception/frames``; the first camera's also into ``frame``.
 
@@ -62,7 +66,10 @@ class GrabFrames(_Sensor):
     previous one (its stamp tells how old it is).
     """
 
-    WRITES = ("/perception/frames", "/perception/frame")
+    PORTS = (
+        OutputPort("frames", dict, "/perception/frames", doc="latest frame of each camera, by camera name"),
+        OutputPort("frame", Frame | LandmarkBearings, "/perception/frame", doc="latest frame of the first camera"),
+    )
 
     def __init__(self, name: str | None = None, *, cameras: tuple[str, ...] | None = None) -> None:
         super().__init__(name=name)
@@ -82,13 +89,20 @@ class GrabFrames(_Sensor):
             cameras = {name: cameras[name] for name in self.only}
         if not cameras:
             return Status.SUCCESS
-        frames = dict(self.read("/perception/frames") or {})
+        try:
+            frames = dict(self.bb.get(self.output_key("frames")))
+        except KeyError:
+            frames = {}
         for name, camera in cameras.items():
             frame = camera.grab()
             if frame is not None:
                 frames[name] = frame
-        self.write("/perception/frames", frames)
+        self.set_output("frames", frames)
         primary = next(iter(cameras))
         if primary in frames:
-            self.write("/perception/frame", frames[primary])
+            self.set_output("frame", frames[primary])
         return Status.SUCCESS
+
+
+SENSE_NODES = (ReadOdometry, ReadPanTilt, GrabFrames)
+"""The runner's own data-gathering nodes, first in every tree."""

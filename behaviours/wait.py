@@ -5,7 +5,7 @@ from __future__ import annotations
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.ports import Param
+from behaviours.ports import InputPort
 from behaviours.registry import register
 
 
@@ -13,10 +13,10 @@ from behaviours.registry import register
 class Wait(BearingsBehaviour):
     """RUNNING for ``duration`` seconds of tree time, then SUCCESS (the robot is not driven)."""
 
-    PARAMS = (Param("duration", "float", unit="s", doc="how long to wait", minimum=0.0),)
+    PORTS = (InputPort("duration", float, unit="s", doc="how long to wait", minimum=0.0),)
 
     def initialise(self) -> None:
-        self._until = self.now() + float(self.param("duration"))
+        self._until = self.now() + float(self.get_input("duration"))
 
     def update(self) -> Status:
         remaining = self._until - self.now()

@@ -3,7 +3,10 @@
 Reading: YAML is parsed with PyYAML's *safe* loader and every mapping and sequence remembers the
 line and column of each entry, so validators anywhere can report ``file:line:col: message``.
 Writing: a temporary file in the same directory, flushed and fsynced, then renamed over the
-target, so a crash never leaves a half-written map, calibration or report.
+target, so a crash never leaves a half-written map, calibration or report. Outputs are checked
+before work starts (:func:`output_problem`); the writer keeps a replaced file's permissions,
+writes through symbolic links, refuses anything that is not a regular file and never creates
+folders silently.
 """
 
 from __future__ import annotations
@@ -197,13 +200,41 @@ def load_yaml(path: str | os.PathLike) -> Any:
     return parse_yaml(text, file=str(path))
 
 
+def output_problem(path: str | os.PathLike) -> str | None:
+    """Why ``path`` cannot be written as an output file, or None (checked before work starts).
+
+    A missing folder, a folder or device in the way, an unwritable folder: each is one line.
+    Symbolic links are written through (the file they point to is replaced atomically).
+    """
+    target = Path(os.path.realpath(path))
+    folder = target.parent
+    if target.exists() and not target.is_file():
+        return "is a directory" if target.is_dir() else "is not a regular file (a device, socket or pipe?)"
+    if not folder.is_dir():
+        return f"the folder {folder} does not exist"
+    if not os.access(folder, os.W_OK | os.X_OK):
+        return f"the folder {folder} is not writable"
+    if target.exists() and not os.access(target, os.W_OK):
+        return "is not writable"
+    return None
+
+
 def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
-    """Write ``data`` so that ``path`` holds either the old content or all of the new one."""
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    """Write ``data`` so that ``path`` holds either the old content or all of the new one.
+
+    The folder must exist (nothing is created silently); a symbolic link is written through; a
+    file that is replaced keeps its permissions, a new one gets the umask's; anything but a
+    regular file in the way (a directory, ``/dev/full``) is refused with ``IsADirectoryError``
+    or ``OSError`` before anything is written.
+    """
+    target = Path(os.path.realpath(path))
+    if target.exists() and not target.is_file():
+        raise (IsADirectoryError if target.is_dir() else OSError)(f"{path}: not a regular file; not replaced")
+    mode = _mode_for(target)
     fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as handle:
+            os.fchmod(handle.fileno(), mode)
             handle.write(data)
             handle.flush()
             os.fsync(handle.fileno())
@@ -221,6 +252,16 @@ def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
         pass
     finally:
         os.close(dir_fd)
+
+
+def _mode_for(target: Path) -> int:
+    """The permissions of the file being replaced, or those the umask gives a new file."""
+    try:
+        return target.stat().st_mode & 0o7777
+    except FileNotFoundError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
 
 
 def write_text_atomic(path: str | os.PathLike, text: str) -> None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import py_trees
 from py_trees.common import ParallelPolicy
 
-from behaviours.registry import lookup
+from behaviours.registry import Registry
 from behaviours.sense import GrabFrames, ReadOdometry, ReadPanTilt
 from missions.language import MissionSpec, NodeSpec
 
@@ -18,29 +18,25 @@ ROOT_NAME = "bearings"
 SENSE_NAME = "sense"
 
 
-def build_node(spec: NodeSpec) -> py_trees.behaviour.Behaviour:
+def build_node(spec: NodeSpec, registry: Registry) -> py_trees.behaviour.Behaviour:
     """The py_trees behaviour (with its subtree) for one validated node."""
-    node_type = lookup(spec.type)
+    node_type = registry.lookup(spec.type)
     if node_type is None:  # the loader checked this; a spec built by hand may not have been
         raise ValueError(f"unknown node type {spec.type!r}")
-    children = [build_node(child) for child in spec.children]
-    if node_type.kind == "composite":
-        return node_type.factory(name=spec.name, children=children, **spec.params)
-    if node_type.kind == "decorator":
-        return node_type.factory(name=spec.name, child=children[0], **spec.params)
-    return node_type.factory(name=spec.name, **spec.params)
+    children = [build_node(child, registry) for child in spec.children]
+    return node_type.build(name=spec.name, children=children, ports=spec.ports)
 
 
 def build_sense(mission: MissionSpec) -> py_trees.behaviour.Behaviour:
     """The data-gathering branch: odometry, pan-tilt, cameras, then the mission's ``sense:``."""
     readings = [ReadOdometry(), ReadPanTilt(), GrabFrames(cameras=mission.cameras)]
-    nodes = [*readings, *(build_node(s) for s in mission.sense)]
+    nodes = [*readings, *(build_node(s, mission.registry) for s in mission.sense)]
     return py_trees.composites.Sequence(name=SENSE_NAME, memory=False, children=nodes)
 
 
 def build_root(mission: MissionSpec) -> tuple[py_trees.behaviour.Behaviour, py_trees.behaviour.Behaviour]:
     """(root, task): the root parallel of sense and task, and the mission's task tree."""
-    task = build_node(mission.tree)
+    task = build_node(mission.tree, mission.registry)
     root = py_trees.composites.Parallel(
         name=ROOT_NAME,
         policy=ParallelPolicy.SuccessOnSelected(children=[task], synchronise=False),

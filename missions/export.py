@@ -1,8 +1,10 @@
 """Views of a mission tree: a unicode outline, Graphviz dot, and BehaviorTree.CPP v4 XML.
 
 The XML (``<root BTCPP_format="4">``) carries a ``TreeNodesModel`` with every bearings node
-type's ports, so Groot2 can open and display the tree. Composites map onto their BT.CPP
-counterparts (``Sequence``/``ReactiveSequence``, ``Fallback``/``ReactiveFallback``, ...).
+type's typed ``input_port`` and ``output_port`` declarations, so Groot2 can open and display the
+tree; every node writes all its ports, outputs as the ``{/ns/key}`` they write. Composites map
+onto their BT.CPP counterparts (``Sequence``/``ReactiveSequence``, ``Fallback``/
+``ReactiveFallback``, ...).
 """
 
 from __future__ import annotations
@@ -10,29 +12,22 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from typing import Any
 
-from behaviours.ports import Ref
-from behaviours.registry import lookup
+from behaviours.ports import REQUIRED, InputPort, OutputPort, Ref, format_literal, type_name
+from behaviours.registry import NodeType, Registry
 from missions.language import MissionSpec, NodeSpec
 
 KIND_GLYPH = {"composite": "", "decorator": "", "action": "--> ", "condition": "--? "}
 BTCPP_MODEL_TAG = {"action": "Action", "condition": "Condition", "decorator": "Decorator", "composite": "Control"}
 
 
-def format_value(value: Any) -> str:
-    if isinstance(value, Ref):
-        return str(value)
-    if isinstance(value, float):
-        return f"{value:g}"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, list):
-        return "[" + ", ".join(format_value(v) for v in value) + "]"
-    return str(value)
+BTCPP_TYPE = {"float": "double", "int": "int", "bool": "bool", "str": "std::string", "key": "std::string"}
 
 
-def _label(node: NodeSpec) -> str:
-    node_type = lookup(node.type)
-    params = ", ".join(f"{k}={format_value(v)}" for k, v in node.params.items())
+def _label(node: NodeSpec, registry: Registry) -> str:
+    node_type = registry.lookup(node.type)
+    shown = {k: v for k, v in node.inputs.items() if v is not None and (not isinstance(v, Ref) or k in node.locations)}
+    shown.update({k: Ref(v) for k, v in node.outputs.items() if k in node.locations})  # remapped outputs
+    params = ", ".join(f"{k}={format_literal(v)}" for k, v in shown.items())
     title = node.type if node.name == node.type else f"{node.name} ({node.type})"
     suffix = f"  [{params}]" if params else ""
     origin = f"  <- {node.included_from}" if node.included_from else ""
@@ -46,16 +41,16 @@ def unicode_tree(mission: MissionSpec) -> str:
     if mission.sense:
         lines.append("├── sense (added to the data-gathering branch)")
         for i, node in enumerate(mission.sense):
-            _outline(node, "│   ", i == len(mission.sense) - 1, lines)
-    _outline(mission.tree, "", True, lines)
+            _outline(node, "│   ", i == len(mission.sense) - 1, lines, mission.registry)
+    _outline(mission.tree, "", True, lines, mission.registry)
     return "\n".join(lines) + "\n"
 
 
-def _outline(node: NodeSpec, prefix: str, last: bool, lines: list[str]) -> None:
-    lines.append(f"{prefix}{'└── ' if last else '├── '}{_label(node)}")
+def _outline(node: NodeSpec, prefix: str, last: bool, lines: list[str], registry: Registry) -> None:
+    lines.append(f"{prefix}{'└── ' if last else '├── '}{_label(node, registry)}")
     inner = prefix + ("    " if last else "│   ")
     for i, child in enumerate(node.children):
-        _outline(child, inner, i == len(node.children) - 1, lines)
+        _outline(child, inner, i == len(node.children) - 1, lines, registry)
 
 
 def dot_tree(mission: MissionSpec) -> str:
@@ -70,9 +65,9 @@ def dot_tree(mission: MissionSpec) -> str:
         nonlocal counter
         counter += 1
         ident = f"n{counter}"
-        node_type = lookup(node.type)
+        node_type = mission.registry.lookup(node.type)
         kind = node_type.kind if node_type else "action"
-        label = _label(node).removeprefix(KIND_GLYPH.get(kind, ""))
+        label = _label(node, mission.registry).removeprefix(KIND_GLYPH.get(kind, ""))
         out.append(f'  {ident} [label="{_esc(label)}", shape={shapes[kind]}, style=filled, '
                    f'fillcolor="{colours[kind]}"];')
         for child in node.children:
@@ -88,31 +83,43 @@ def btcpp_xml(mission: MissionSpec) -> str:
     """BehaviorTree.CPP v4 XML with a TreeNodesModel, for Groot2."""
     root = ET.Element("root", {"BTCPP_format": "4", "main_tree_to_execute": _ident(mission.name)})
     tree = ET.SubElement(root, "BehaviorTree", {"ID": _ident(mission.name)})
-    used: dict[str, Any] = {}
-    tree.append(_xml_node(mission.tree, used))
+    used: dict[str, NodeType] = {}
+    tree.append(_xml_node(mission.tree, used, mission.registry))
     model = ET.SubElement(root, "TreeNodesModel")
-    builtin = {"Sequence", "ReactiveSequence", "Fallback", "ReactiveFallback", "Parallel", "Inverter",
-               "ForceSuccess", "ForceFailure", "RetryUntilSuccessful", "Repeat", "Timeout", "RunOnce",
-               "AlwaysSuccess", "AlwaysFailure", "Precondition"}
     for tag, node_type in sorted(used.items()):
-        if tag in builtin:
+        if tag in BTCPP_BUILTIN:
             continue
         element = ET.SubElement(model, BTCPP_MODEL_TAG[node_type.kind], {"ID": tag})
-        for param in node_type.params:
-            attrs = {"name": param.name, "type": param.type}
-            if not param.required:
-                attrs["default"] = format_value(param.default)
-            port = ET.SubElement(element, "input_port", attrs)
-            port.text = param.doc + (f" [{param.unit}]" if param.unit else "")
+        for port in (*node_type.inputs, *node_type.outputs):
+            _model_port(element, port)
     ET.indent(root)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def _xml_node(node: NodeSpec, used: dict[str, Any]) -> ET.Element:
-    node_type = lookup(node.type)
-    tag = node_type.btcpp or node.type
+BTCPP_BUILTIN = {"Sequence", "ReactiveSequence", "Fallback", "ReactiveFallback", "Parallel", "Inverter",
+                 "ForceSuccess", "ForceFailure", "RetryUntilSuccessful", "Repeat", "Timeout", "RunOnce",
+                 "AlwaysSuccess", "AlwaysFailure", "Precondition"}
+
+
+def _model_port(element: ET.Element, port: InputPort | OutputPort) -> None:
+    """One ``input_port``/``output_port`` of a node type in the TreeNodesModel."""
+    name = type_name(port.type)
+    attrs = {"name": port.name, "type": BTCPP_TYPE.get(name, name)}
+    if isinstance(port, OutputPort):
+        attrs["default"] = "{" + port.key + "}"
+    elif port.default is not REQUIRED and port.default is not None:
+        attrs["default"] = format_literal(port.default)
+    tag = "output_port" if isinstance(port, OutputPort) else "input_port"
+    ET.SubElement(element, tag, attrs).text = port.doc + (f" [{port.unit}]" if port.unit else "")
+
+
+def _xml_node(node: NodeSpec, used: dict[str, NodeType], registry: Registry) -> ET.Element:
+    node_type = registry.lookup(node.type)
+    if node_type is None:
+        raise ValueError(f"unknown node type {node.type!r}")
+    tag = node_type.btcpp
     attrs: dict[str, str] = {}
-    params = dict(node.params)
+    params: dict[str, Any] = dict(node.inputs)
     if node.type in ("Sequence", "Selector"):
         if not params.pop("memory", True):
             tag = "Reactive" + tag
@@ -127,16 +134,19 @@ def _xml_node(node: NodeSpec, used: dict[str, Any]) -> ET.Element:
         params.pop("policy")
     elif node.type == "Guard":
         key, op, value = params.pop("key"), params.pop("op"), params.pop("value")
-        attrs["if"] = f"{{{key}}} {op} {format_value(value)}"
+        attrs["if"] = f"{{{key}}} {op} {format_literal(value)}"
         attrs["else"] = "FAILURE"
     for key, value in params.items():
-        attrs[key] = format_value(value)
+        if value is not None:
+            attrs[key] = format_literal(value)
+    for key, target in node.outputs.items():
+        attrs[key] = "{" + target + "}"
     if node.name != node.type:
         attrs = {"name": node.name, **attrs}
     used[tag] = node_type
     element = ET.Element(tag, attrs)
     for child in node.children:
-        element.append(_xml_node(child, used))
+        element.append(_xml_node(child, used, registry))
     return element
 
 

@@ -6,7 +6,7 @@ The YAML syntax (see docs/missions.md)::
     description: Drive a 1 m square.
     inputs:                             # substituted at load time as ${side}; --set side=2
       side: {type: float, default: 1.0, unit: m, description: length of a side}
-    plugins: [my_robot.behaviours]      # modules to import, explicitly
+    plugins: [my_robot.behaviours]      # modules whose node types the mission may use, explicitly
     rate: 10                            # tick rate in Hz
     tree:                               # one node: TypeName: {parameters}
       Sequence:
@@ -22,7 +22,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from behaviours.ports import Param
+from behaviours.ports import InputPort
+from behaviours.registry import Registry
 
 
 @dataclass(frozen=True)
@@ -39,14 +40,30 @@ class Location:
 
 @dataclass(frozen=True)
 class NodeSpec:
-    """One validated node: its registered type, name, bound parameters and children."""
+    """One validated node: its registered type, name, bound ports and children.
+
+    ``inputs`` maps every input port to its literal or :class:`~behaviours.ports.Ref` (defaults
+    filled in); ``outputs`` maps every output port to the blackboard key it writes (remapped or
+    the port's default); ``locations`` says where each port given in the file was written.
+    """
 
     type: str
     name: str
-    params: dict[str, Any]
+    inputs: dict[str, Any]
     children: tuple[NodeSpec, ...] = ()
     location: Location = Location("<unknown>")
     included_from: str | None = None  # the include file this node's subtree came from
+    outputs: dict[str, str] = field(default_factory=dict)
+    locations: dict[str, Location] = field(default_factory=dict, compare=False)
+
+    @property
+    def ports(self) -> dict[str, Any]:
+        """Inputs and outputs together, as a mission writes them (outputs as keys)."""
+        return {**self.inputs, **self.outputs}
+
+    def where(self, port: str) -> Location:
+        """Where a port was written (the node itself for a default)."""
+        return self.locations.get(port, self.location)
 
     def walk(self):
         """This node and all nodes below it, depth first."""
@@ -63,12 +80,14 @@ class MissionSpec:
     file: str
     tree: NodeSpec
     description: str = ""
-    inputs: dict[str, Param] = field(default_factory=dict)
+    inputs: dict[str, InputPort] = field(default_factory=dict)
     values: dict[str, Any] = field(default_factory=dict)
     sense: tuple[NodeSpec, ...] = ()
     plugins: tuple[str, ...] = ()
     rate_hz: float = 10.0
     max_time_s: float | None = None
+    overrun_s: float = 1.0  # how far a tick may overrun its period before the watchdog stops the base
     evaluation: dict[str, Any] = field(default_factory=dict)
     cameras: tuple[str, ...] | None = None  # the cameras this mission grabs; None: every camera
     files: tuple[str, ...] = ()  # this file and every file it includes
+    registry: Registry = field(default_factory=Registry.default, compare=False, repr=False)

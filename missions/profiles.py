@@ -1,4 +1,4 @@
-"""Robot profiles: which drivers a real robot uses, on which ports (``--robot ROBOT.yaml``).
+"""Robot profiles: which drivers a real robot uses, with which settings (``--robot ROBOT.yaml``).
 
 A profile names a driver for the base, optionally the pan-tilt unit and cameras::
 
@@ -8,112 +8,166 @@ A profile names a driver for the base, optionally the pan-tilt unit and cameras:
     cameras:
       omni: {driver: opencv, device: 0, calibration: omni.yaml}
 
-Drivers are looked up in :data:`DRIVERS` (``module:function``); each opener takes the entry's
-settings and returns the device. Nothing is opened until the whole profile is valid, and a
-device that fails to open closes the ones already open.
+The profile's shape is the declared model :class:`RobotProfile`; each device's settings are the
+declared model of its driver: the type of the ``settings`` argument of the driver's opener
+(``open_base(settings: PioneerSettings)``), so a driver declares its settings (units, ranges)
+once, where it is written. Both are checked with located errors (:mod:`maps.located`), like
+missions and worlds. Nothing is opened until the whole profile is valid, and a device that fails
+to open closes the ones already open.
 """
 
 from __future__ import annotations
 
 import contextlib
 import importlib
+import typing
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
 from drivers.interfaces import Robot
+from maps.located import FILE_MODEL_CONFIG, diagnose, suggest, validate
 from maps.store import Diagnostic, InputError, YamlMap, load_yaml
 
 PROFILES = Path(__file__).resolve().parent.parent / "drivers" / "profiles"
+Role = Literal["base", "ptu", "camera"]
 DRIVERS: dict[str, dict[str, str]] = {
-    # role -> driver name -> "module:opener"; the hardware drivers register here as they land
+    # role -> driver name -> "module:opener"; the opener's `settings` parameter declares the settings
     "base": {"pioneer": "drivers.pioneer:open_base"},
     "ptu": {"ptu_d46": "drivers.ptu_d46:open_ptu"},
-    "camera": {"opencv": "drivers.cameras:open_opencv_camera"},
+    "camera": {"opencv": "drivers.cameras:open_opencv_camera", "http": "drivers.cameras:open_http_camera"},
 }
-TOP_KEYS = ("robot", "description", "base", "ptu", "cameras")
+
+
+class DeviceEntry(BaseModel):
+    """One device: its driver's name, then that driver's own settings."""
+
+    model_config = ConfigDict(extra="allow", strict=True, frozen=True)
+
+    driver: str = Field(min_length=1, description="the driver (its settings follow)")
+
+
+class RobotProfile(BaseModel):
+    """A robot profile file."""
+
+    model_config = FILE_MODEL_CONFIG
+
+    robot: str | None = Field(None, min_length=1, max_length=200, description="the robot's name (default: the file "
+                              "name)")
+    description: str = Field("", max_length=20_000)
+    base: DeviceEntry = Field(description="the differential-drive base")
+    ptu: DeviceEntry | None = Field(None, description="the pan-tilt unit, if any")
+    cameras: dict[str, DeviceEntry] = Field(default_factory=dict, max_length=32, description="cameras by name")
 
 
 @dataclass(frozen=True)
-class DeviceEntry:
-    role: str
+class Device:
+    """A validated device of a profile: ready to open."""
+
+    role: Role
     name: str
     driver: str
-    settings: dict[str, Any]
-    opener: Callable[..., Any]
+    settings: BaseModel
+    opener: Callable[[Any], Any]
 
 
-def load_profile(path: str | Path) -> tuple[str, list[DeviceEntry]]:
-    """Validate a profile and resolve its drivers; raise :class:`InputError` with every problem."""
+def load_profile(path: str | Path) -> tuple[str, list[Device]]:
+    """Validate a profile and its devices' settings; raise :class:`InputError` with every problem."""
     file = str(path)
     doc = load_yaml(path)
-    problems: list[Diagnostic] = []
-
-    def error(mark: Any, message: str) -> None:
-        problems.append(Diagnostic(file, mark.line, mark.col, message))
-
     if not isinstance(doc, YamlMap):
         raise InputError([Diagnostic(file, 1, 1, "a robot profile is a mapping with at least 'base:'")])
-    for key in doc:
-        if key not in TOP_KEYS:
-            error(doc.mark_of(key), f"unknown profile entry {key!r} (entries: {', '.join(TOP_KEYS)})")
-    entries: list[DeviceEntry] = []
-    sections: list[tuple[str, str, Any, Any]] = []
-    if "base" not in doc:
-        error(doc.mark, "the profile has no 'base:' driver")
-    else:
-        sections.append(("base", "base", doc["base"], doc.value_mark_of("base")))
-    if doc.get("ptu") is not None:
-        sections.append(("ptu", "ptu", doc["ptu"], doc.value_mark_of("ptu")))
-    cameras = doc.get("cameras")
-    if cameras is not None:
-        if not isinstance(cameras, YamlMap):
-            error(doc.value_mark_of("cameras"), "'cameras:' maps camera names to driver settings")
-        else:
-            sections.extend(("camera", str(n), c, cameras.value_mark_of(n)) for n, c in cameras.items())
-    for role, name, entry, mark in sections:
-        if not isinstance(entry, YamlMap) or not isinstance(entry.get("driver"), str):
-            error(mark, f"{name}: expected a mapping with 'driver:' ({', '.join(DRIVERS[role])})")
-            continue
-        driver = entry["driver"]
-        target = DRIVERS[role].get(driver)
-        if target is None:
-            error(entry.value_mark_of("driver"), f"{name}: unknown {role} driver {driver!r} "
-                  f"(known: {', '.join(DRIVERS[role])})")
-            continue
-        module_name, _, function = target.partition(":")
+    profile = validate(RobotProfile, doc, file=file)
+    entries: list[tuple[Role, str, DeviceEntry, YamlMap]] = [("base", "base", profile.base, doc["base"])]
+    if profile.ptu is not None:
+        entries.append(("ptu", "ptu", profile.ptu, doc["ptu"]))
+    entries += [("camera", name, entry, doc["cameras"][name]) for name, entry in profile.cameras.items()]
+    devices: list[Device] = []
+    problems: list[Diagnostic] = []
+    for role, name, entry, raw in entries:
         try:
-            opener = getattr(importlib.import_module(module_name), function)
-        except (ModuleNotFoundError, AttributeError):
-            error(entry.value_mark_of("driver"), f"{name}: the {driver!r} driver is not part of this version "
-                  "of bearings yet; run in the simulator with --sim")
-            continue
-        settings = {k: v for k, v in entry.items() if k != "driver"}
-        entries.append(DeviceEntry(role, name, driver, settings, opener))
+            devices.append(_device(role, name, entry, raw, file))
+        except InputError as exc:
+            problems += exc.diagnostics
     if problems:
         raise InputError(problems)
-    return str(doc.get("robot", Path(file).stem)), entries
+    return profile.robot or Path(file).stem, devices
+
+
+def _device(role: Role, name: str, entry: DeviceEntry, raw: YamlMap, file: str) -> Device:
+    mark = raw.value_mark_of("driver")
+    known = DRIVERS[role]
+    target = known.get(entry.driver)
+    if target is None:
+        raise InputError([Diagnostic(file, mark.line, mark.col, f"{name}: unknown {role} driver {entry.driver!r}"
+                                     f"{suggest(entry.driver, known)} (known: {', '.join(known)})")])
+    opener, settings_model = _opener(target)
+    if opener is None or settings_model is None:
+        raise InputError([Diagnostic(file, mark.line, mark.col, f"{name}: the {entry.driver!r} driver is not part "
+                                     "of this version of bearings yet; run in the simulator with --sim")])
+    settings = {k: v for k, v in raw.items() if k != "driver"}
+    located = YamlMap(settings)
+    located.mark, located.key_marks, located.value_marks = raw.mark, raw.key_marks, raw.value_marks
+    try:
+        value = settings_model.model_validate(located, context={"folder": str(Path(file).parent)})
+    except ValidationError as exc:
+        path = ("cameras", name) if role == "camera" else (role,)
+        raise InputError(diagnose(exc, located, file=file, model=settings_model, path=path)) from None
+    return Device(role, name, entry.driver, value, opener)
+
+
+def _opener(target: str) -> tuple[Callable[[Any], Any] | None, type[BaseModel] | None]:
+    """A driver's opener and its declared settings model, or (None, None) when the driver is absent."""
+    module_name, _, function = target.partition(":")
+    try:
+        opener = getattr(importlib.import_module(module_name), function)
+    except (ModuleNotFoundError, AttributeError):
+        return None, None
+    hints = typing.get_type_hints(opener)
+    model = hints.get("settings")
+    return opener, model if isinstance(model, type) and issubclass(model, BaseModel) else None
 
 
 def open_robot(path: str | Path) -> Robot:
     """Open every device of a valid profile; on any failure close what was opened and re-raise."""
-    name, entries = load_profile(path)
+    name, devices = load_profile(path)
     opened: list[Any] = []
     try:
         base, ptu, cameras = None, None, {}
-        for entry in entries:
-            device = entry.opener(**entry.settings)
-            opened.append(device)
-            if entry.role == "base":
-                base = device
-            elif entry.role == "ptu":
-                ptu = device
+        for device in devices:
+            handle = device.opener(device.settings)
+            opened.append(handle)
+            if device.role == "base":
+                base = handle
+            elif device.role == "ptu":
+                ptu = handle
             else:
-                cameras[entry.name] = device
-        return Robot(base=base, ptu=ptu, cameras=cameras, name=name)
+                cameras[device.name] = handle
+        return Robot(base=base, ptu=ptu, cameras=cameras, name=name)  # type: ignore[arg-type]
     except BaseException:
-        for device in reversed(opened):
+        for handle in reversed(opened):
             with contextlib.suppress(Exception):  # already failing; close the rest
-                device.close()
+                handle.close()
         raise
+
+
+def profile_schema() -> dict[str, Any]:
+    """JSON Schema of profiles: each role's entry is one of the installed drivers' settings models."""
+    roles: dict[str, Any] = {}
+    for role, drivers in DRIVERS.items():
+        variants = []
+        for driver, target in drivers.items():
+            _, settings_model = _opener(target)
+            if settings_model is not None:
+                variants.append(create_model(f"{settings_model.__name__}Entry", __base__=settings_model,
+                                             driver=(Literal[driver], Field(description="the driver"))))
+        roles[role] = typing.Union[tuple(variants)] if variants else DeviceEntry  # noqa: UP007 - built at run time
+    base, ptu, camera = roles["base"], roles["ptu"], roles["camera"]
+    model = create_model("RobotProfileSchema", __base__=RobotProfile, base=(base, ...), ptu=(ptu | None, None),
+                         cameras=(dict[str, camera], {}))  # type: ignore[valid-type]
+    schema = model.model_json_schema()
+    schema["title"] = "bearings robot profile"
+    return schema

@@ -6,6 +6,7 @@ viewer, so it works headless; open the file later with ``rerun F.rrd``.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +32,7 @@ class Recorder:
         rr.log("tree/status_legend", rr.TextDocument("0 invalid, 1 running, 2 success, 3 failure"), static=True)
 
     def log_tick(self, *, time_s: float, tick: int, root: py_trees.behaviour.Behaviour, odometry: Any,
-                 command: Any, simulation: Any = None) -> None:
+                 command: Any, observers: Sequence[Any] = ()) -> None:
         rr = self.rr
         rr.set_time(self.timeline, duration=time_s)
         rr.set_time("tick", sequence=tick)
@@ -49,8 +50,17 @@ class Recorder:
                 message = f"{path}: {node.status.value}" + (f" ({node.feedback_message})"
                                                              if node.feedback_message else "")
                 rr.log("tree/events", rr.TextLog(message))
-        if simulation is not None:
-            simulation.log_rerun(rr)
+        for observer in observers:
+            observer.log_rerun(rr)
+
+    def log_stop(self, *, time_s: float, tick: int) -> None:
+        """The stop every run ends with: the last command in the recording is a zero velocity."""
+        rr = self.rr
+        rr.set_time(self.timeline, duration=time_s)
+        rr.set_time("tick", sequence=tick)
+        rr.log("robot/command/v", rr.Scalars([0.0]))
+        rr.log("robot/command/w", rr.Scalars([0.0]))
+        rr.log("tree/events", rr.TextLog("run ended: base and pan-tilt unit commanded to stop"))
 
     def close(self) -> None:
         self.rr.disconnect()

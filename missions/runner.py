@@ -1,48 +1,69 @@
 """Run a mission: tick the tree at a fixed rate, turn its commands into driver calls, stop safely.
 
-Safety rules, whatever happens: when the tree ends, when a behaviour raises, on Ctrl-C or
-SIGTERM, when the time limit passes, the runner commands the base and the pan-tilt unit to stop
-before it closes any driver, and the report is written (atomically) before the process exits.
-An exception inside the tree becomes a mission FAILURE with a one-line reason, not a crash.
+The tree is a py_trees :class:`~py_trees.trees.BehaviourTree`: its ``setup`` hands every node the
+clock and the drivers, a pre-tick handler clears the command keys (a command lives for the tick
+that wrote it), post-tick handlers dispatch the commands to the drivers and record the tick.
+Between ticks the runner calls ``clock.next_tick(period)``: on a robot that waits for wall
+time, in the simulator it steps the world (the simulator is a driver the clock steps), so the
+loop has no simulation branch. Whatever ends the run, the report is written:
 
-In the simulator the runner steps the world by the tick period after every tick and runs as fast
-as it can (or at wall-clock pace with ``realtime``); on a robot it paces ticks on the monotonic
-clock. Behaviours only ever see the clock handed to them.
+=========================  ===========  =======================================================
+how the run ends           status       exit code
+=========================  ===========  =======================================================
+the tree succeeds          SUCCESS      0
+the tree fails             FAILURE      1
+a behaviour raises         FAILURE      1 (reason names the behaviour; SystemExit included)
+the time limit             FAILURE      1
+the tick watchdog          FAILURE      1 (reason names the blocking behaviour; on a robot,
+                                        or in simulation with ``--overrun``)
+SIGINT / SIGTERM           INTERRUPTED  130 / 143, even while a behaviour blocks
+=========================  ===========  =======================================================
+
+In every case the base and the pan-tilt unit are commanded to stop before any driver closes,
+and the last command recorded (report and recording) is a zero velocity.
 """
 
 from __future__ import annotations
 
 import contextlib
-import signal
+import os
 import sys
-import threading
 import time
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import py_trees
 from py_trees.common import Status
 
-from behaviours.clock import Clock, ManualClock, MonotonicClock
+from behaviours.clock import TickClock
+from behaviours.keys import COMMAND_KEYS, input_key
 from drivers.interfaces import STOP, PanTiltCommand, Robot, VelocityCommand
 from maps.store import write_json
 from missions.builder import build_root
+from missions.clocks import WallClock
 from missions.language import MissionSpec
 from missions.recording import Recorder
+from missions.safety import Interrupted, SafetyMonitor, exit_code
 
-COMMAND_KEYS = ("/robot/command", "/ptu/command")
+
+class RunObserver(Protocol):
+    """Something beside the robot that watches a run (the simulator's ground truth)."""
+
+    def report_sections(self, evaluation: Mapping[str, Any]) -> dict[str, Any]: ...
+
+    def log_rerun(self, rec: Any) -> None: ...
 
 
 @dataclass
 class RunOptions:
-    """How to run: tick rate (None: the mission's), time limit, pacing, outputs."""
+    """How to run: tick rate (None: the mission's), limits, outputs."""
 
     rate_hz: float | None = None
     max_time_s: float | None = None
-    realtime: bool = False
+    overrun_s: float | None = None  # tick watchdog limit; None: the mission's on a robot, none in simulation
     report_path: Path | None = None
     save_path: Path | None = None
     progress: bool = False
@@ -59,9 +80,12 @@ class RunResult:
     ticks: int
     time_s: float
     report: dict[str, Any] = field(default_factory=dict)
+    signum: int | None = None
 
     @property
     def exit_code(self) -> int:
+        if self.signum is not None:
+            return exit_code(self.signum)
         return 0 if self.status == "SUCCESS" else 1
 
 
@@ -73,92 +97,91 @@ class Runner:
         mission: MissionSpec,
         robot: Robot,
         *,
-        simulation: Any = None,
-        clock: Clock | None = None,
+        clock: TickClock | None = None,
         options: RunOptions | None = None,
+        observers: Sequence[RunObserver] = (),
         on_tick: Callable[[Runner], None] | None = None,
     ) -> None:
         self.mission = mission
         self.robot = robot
-        self.simulation = simulation
         self.options = options or RunOptions()
-        self.clock = clock or (ManualClock() if simulation is not None else MonotonicClock())
+        self.clock: TickClock = clock or WallClock()
+        self.observers = tuple(observers)
         self.on_tick = on_tick
         self.rate_hz = self.options.rate_hz or mission.rate_hz
         self.period = 1.0 / self.rate_hz
         self.max_time = self.options.max_time_s if self.options.max_time_s is not None else mission.max_time_s
-        self.ticks = 0
-        self._stop_request: str | None = None
-        self._last_ptu: PanTiltCommand | None = None
         self.last_command: VelocityCommand = STOP
+        self._last_ptu: PanTiltCommand | None = None
+        self._recorder: Recorder | None = None
+        self._wall_start = time.monotonic()
         py_trees.blackboard.Blackboard.clear()  # one run, one blackboard: nothing leaks between runs
-        self.root, self.task = build_root(mission)
+        root, self.task = build_root(mission)
+        self.tree = py_trees.trees.BehaviourTree(root)
+        self.tree.add_pre_tick_handler(self._clear_commands)
+        self.tree.add_post_tick_handler(self._dispatch)
         self.blackboard = py_trees.blackboard.Client(name="runner")
-        for key in COMMAND_KEYS:
-            self.blackboard.register_key(key=key, access=py_trees.common.Access.WRITE)
+        for spec in COMMAND_KEYS:
+            self.blackboard.register_key(key=spec.path, access=py_trees.common.Access.WRITE)
+        overrun = self.options.overrun_s
+        if overrun is None and self.clock.timeline == "wall_time":
+            overrun = mission.overrun_s  # simulated time stands still during a slow tick: no watchdog by default
+        self.monitor = SafetyMonitor(robot, period=self.period, overrun_limit=overrun,
+                                     emergency_exit=self._emergency_exit)
 
-    # -- control -------------------------------------------------------------------------------
-    def request_stop(self, reason: str) -> None:
-        """Ask the loop to end at the next tick boundary (signal handlers call this)."""
-        self._stop_request = reason
+    @property
+    def root(self) -> py_trees.behaviour.Behaviour:
+        return self.tree.root
 
+    @property
+    def ticks(self) -> int:
+        return self.tree.count
+
+    # -- the run ---------------------------------------------------------------------------------
     def run(self) -> RunResult:
         status, reason = "FAILURE", "not started"
-        recorder = None
-        restore = self._install_signal_handlers()
-        start_wall = time.monotonic()
-        try:
-            if self.options.save_path is not None:
-                recorder = Recorder(self.options.save_path, mission=self.mission.name,
-                                    recording_id=f"{self.mission.name}-seed{self.options.seed}",
-                                    timeline="sim_time" if self.simulation is not None else "wall_time")
-            for node in self.root.iterate():  # hand every node the clock and the drivers
-                node.setup(clock=self.clock, robot=self.robot)
-            status, reason = self._loop(recorder, start_wall)
-        except Exception as exc:  # noqa: BLE001 - any failure becomes a FAILURE, robot stopped
-            status, reason = "FAILURE", describe_exception(exc)
-            if self.options.debug:
-                traceback.print_exc()
-        finally:
-            self.robot.stop_all()  # the last command sent is always a stop
-            self._halt_tree()
-            if recorder is not None:
-                with contextlib.suppress(Exception):  # the run's outcome matters more than the file
-                    recorder.close()
-            restore()
-            if self.options.progress:
-                sys.stderr.write("\n")
-        elapsed = self.clock.now()
-        result = RunResult(status, reason, self.ticks, elapsed)
-        result.report = self._report(result, time.monotonic() - start_wall)
-        if self.options.report_path is not None:
-            write_json(self.options.report_path, result.report)
-        return result
+        with self.monitor:
+            try:
+                self._start()
+                status, reason = self._loop()
+            except Interrupted:
+                status, reason = "INTERRUPTED", self.monitor.stopped_reason or "interrupted"
+            except BaseException as exc:  # noqa: BLE001 - whatever a behaviour raises ends the run as FAILURE
+                status, reason = "FAILURE", describe_exception(exc)
+                if self.options.debug:
+                    traceback.print_exc()
+            finally:
+                self.monitor.disarm()
+                self._finish()
+            if self.monitor.signum is not None:  # a signal during the last tick or the wind-down
+                status, reason = "INTERRUPTED", self.monitor.stopped_reason or reason
+        return self._result(status, reason)
 
-    # -- the loop ------------------------------------------------------------------------------
-    def _loop(self, recorder: Recorder | None, start_wall: float) -> tuple[str, str]:
+    def _start(self) -> None:
+        if self.options.save_path is not None:
+            self._recorder = Recorder(self.options.save_path, mission=self.mission.name,
+                                      recording_id=f"{self.mission.name}-seed{self.options.seed}",
+                                      timeline=self.clock.timeline)
+        for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
+            py_trees.blackboard.Blackboard.set(input_key(name), value)
+        self.tree.setup(clock=self.clock, robot=self.robot)  # hand every node the clock and the drivers
+
+    def _loop(self) -> tuple[str, str]:
         last_progress = 0.0
         while True:
-            if self._stop_request:
-                return "FAILURE", self._stop_request
+            stop = self.monitor.stopped_reason
+            if stop is not None:
+                return ("INTERRUPTED" if self.monitor.signum is not None else "FAILURE"), stop
             now = self.clock.now()
             if self.max_time is not None and now >= self.max_time - 1e-9:
                 return "FAILURE", f"time limit of {self.max_time:g} s reached"
-            for key in COMMAND_KEYS:  # a command is valid for the tick that wrote it only
-                self.blackboard.unset(key)
-            tick_started = time.monotonic()
+            self.monitor.tick_started()
             try:
-                self.root.tick_once()
-            except Exception as exc:  # noqa: BLE001
-                if self.options.debug:
-                    traceback.print_exc()
-                return "FAILURE", describe_exception(exc)
-            self.ticks += 1
-            self._act()
-            if recorder is not None:
-                recorder.log_tick(time_s=now, tick=self.ticks, root=self.root,
-                                  odometry=self._get("/robot/odometry"), command=self.last_command,
-                                  simulation=self.simulation)
+                self.tree.tick()
+            finally:
+                self.monitor.tick_finished()
+            if self.monitor.fault is not None:
+                return "FAILURE", self.monitor.fault
             if self.on_tick is not None:
                 self.on_tick(self)
             if self.options.progress and time.monotonic() - last_progress > 0.2:
@@ -166,41 +189,67 @@ class Runner:
                 self._print_progress(now)
             if self.root.status in (Status.SUCCESS, Status.FAILURE):
                 return self.root.status.value, self._outcome_reason()
-            self._advance(tick_started)
+            self.clock.next_tick(self.period)
 
-    def _act(self) -> None:
+    def _finish(self) -> None:
+        """Stop everything, halt the tree, record the stop (runs whatever happened)."""
+        self.robot.stop_all()  # the last command sent is always a stop
+        self.last_command = STOP
+        with contextlib.suppress(Exception):  # halting must not mask the outcome
+            if self.root.status == Status.RUNNING:
+                self.root.stop(Status.INVALID)
+        if self._recorder is not None:
+            with contextlib.suppress(Exception):  # the run's outcome matters more than the file
+                self._recorder.log_stop(time_s=self.clock.now(), tick=self.ticks)
+                self._recorder.close()
+        if self.options.progress:
+            sys.stderr.write("\n")
+
+    def _result(self, status: str, reason: str) -> RunResult:
+        result = RunResult(status, reason, self.ticks, self.clock.now(), signum=self.monitor.signum)
+        result.report = self._report(result)
+        if self.options.report_path is not None:
+            write_json(self.options.report_path, result.report)
+        return result
+
+    def _emergency_exit(self, signum: int) -> None:
+        """Called by the monitor when a signal came and the loop is stuck: report, then end the process."""
+        self.robot.stop_all()
+        with contextlib.suppress(Exception):
+            reason = f"{self.monitor.stopped_reason}; the tree did not return, the process was ended"
+            self._result("INTERRUPTED", reason)
+        with contextlib.suppress(Exception):
+            if self._recorder is not None:
+                self._recorder.log_stop(time_s=self.clock.now(), tick=self.ticks)
+                self._recorder.close()
+        os._exit(exit_code(signum))
+
+    # -- tick handlers ---------------------------------------------------------------------------
+    def _clear_commands(self, _tree: py_trees.trees.BehaviourTree) -> None:
+        for spec in COMMAND_KEYS:  # a command is valid for the tick that wrote it only
+            self.blackboard.unset(spec.path)
+
+    def _dispatch(self, _tree: py_trees.trees.BehaviourTree) -> None:
+        if self.monitor.stopped_reason is not None:
+            return  # the monitor stopped the base: the tree's command must not restart it
         command = self._get("/robot/command")
-        if not isinstance(command, VelocityCommand):
-            command = STOP
-        self.last_command = command
-        self.robot.base.drive(command.v, command.w)
+        self.last_command = command if isinstance(command, VelocityCommand) else STOP
+        self.robot.base.drive(self.last_command.v, self.last_command.w)
         ptu_command = self._get("/ptu/command")
         if self.robot.ptu is not None and isinstance(ptu_command, PanTiltCommand) and ptu_command != self._last_ptu:
             self.robot.ptu.move(ptu_command.pan, ptu_command.tilt, ptu_command.speed)
             self._last_ptu = ptu_command
+        if self._recorder is not None:
+            self._recorder.log_tick(time_s=self.clock.now(), tick=self.ticks + 1, root=self.root,
+                                    odometry=self._get("/robot/odometry"), command=self.last_command,
+                                    observers=self.observers)
 
-    def _advance(self, tick_started: float) -> None:
-        if self.simulation is not None:
-            self.simulation.step(self.period)
-            self.clock.set(self.ticks * self.period)  # no drift from summing the period
-            if self.options.realtime:
-                time.sleep(max(0.0, self.period - (time.monotonic() - tick_started)))
-        else:
-            time.sleep(max(0.0, self.period - (time.monotonic() - tick_started)))
-
-    # -- helpers -------------------------------------------------------------------------------
+    # -- helpers ---------------------------------------------------------------------------------
     def _get(self, key: str) -> Any:
         try:
             return py_trees.blackboard.Blackboard.get(key)
         except KeyError:
             return None
-
-    def _halt_tree(self) -> None:
-        try:
-            if self.root.status == Status.RUNNING:
-                self.root.stop(Status.INVALID)
-        except Exception:  # noqa: BLE001 - halting must not mask the original outcome
-            pass
 
     def _outcome_reason(self) -> str:
         if self.root.status == Status.SUCCESS:
@@ -220,24 +269,7 @@ class Runner:
         sys.stderr.write("\r" + line[:110].ljust(110))
         sys.stderr.flush()
 
-    def _install_signal_handlers(self) -> Callable[[], None]:
-        if threading.current_thread() is not threading.main_thread():
-            return lambda: None
-        previous = {}
-
-        def handler(signum: int, _frame: Any) -> None:
-            self.request_stop(f"interrupted by {signal.Signals(signum).name}")
-
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            previous[sig] = signal.signal(sig, handler)
-
-        def restore() -> None:
-            for sig, old in previous.items():
-                signal.signal(sig, old)
-
-        return restore
-
-    def _report(self, result: RunResult, wall_s: float) -> dict[str, Any]:
+    def _report(self, result: RunResult) -> dict[str, Any]:
         mission = self.mission
         report: dict[str, Any] = {
             "mission": mission.name,
@@ -246,15 +278,15 @@ class Runner:
             "reason": result.reason,
             "ticks": result.ticks,
             "rate_hz": self.rate_hz,
-            "wall_time_s": round(wall_s, 3),
+            "wall_time_s": round(time.monotonic() - self._wall_start, 3),
             "inputs": {k: v for k, v in mission.values.items() if _jsonable(v)},
             "seed": self.options.seed,
+            "last_command": {"v": self.last_command.v, "w": self.last_command.w},
         }
-        if self.simulation is not None:
+        if self.clock.timeline == "sim_time":
             report["sim_time_s"] = round(result.time_s, 6)
-            report["ground_truth"] = self.simulation.ground_truth_report(
-                goal=mission.evaluation.get("goal"), reference_path=mission.evaluation.get("reference_path"),
-                frame=mission.evaluation.get("frame", "world"))
+        for observer in self.observers:
+            report.update(observer.report_sections(mission.evaluation))
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}

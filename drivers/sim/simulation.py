@@ -1,7 +1,8 @@
 """The simulated robot: world, base, pan-tilt and cameras stepped by the runner's clock.
 
 The runner only uses this API: :meth:`Simulation.load`, :attr:`Simulation.robot`,
-:meth:`Simulation.step`, :meth:`Simulation.ground_truth_report` and :meth:`Simulation.log_rerun`;
+:meth:`Simulation.clock` (which steps the world), :meth:`Simulation.report_sections` and
+:meth:`Simulation.log_rerun`;
 perception benchmarks and ``bearings sim snapshot`` use :meth:`Simulation.snapshot`.
 Ground truth stays in here; behaviours only see the :class:`~drivers.interfaces.Robot`
 interfaces, exactly as on hardware.
@@ -15,7 +16,7 @@ bit-identical images and reports.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -31,6 +32,29 @@ from drivers.sim.visualise import RerunLogger
 from drivers.sim.world import World, empty_world, load_world
 from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
+
+
+class SimClock:
+    """Simulated time for the runner: :meth:`next_tick` steps the world by the tick period.
+
+    Time is ``ticks * period`` exactly (no drift from summing the period), so a 5 s timeout in a
+    mission lasts 50 ticks at 10 Hz whatever the floating-point history.
+    """
+
+    timeline = "sim_time"
+
+    def __init__(self, sim: Simulation) -> None:
+        self._sim = sim
+        self._ticks = 0
+        self._now = 0.0
+
+    def now(self) -> float:
+        return self._now
+
+    def next_tick(self, period: float) -> None:
+        self._sim.step(period)
+        self._ticks += 1
+        self._now = self._ticks * period
 
 
 class SimBase:
@@ -159,8 +183,19 @@ class Simulation:
         values = [self.scene.clearance(*(start + (end - start) * (i / samples))) for i in range(1, samples + 1)]
         return min(values), values[-1]
 
+    def clock(self) -> SimClock:
+        """A fresh clock that steps this world once per tick (hand it to the runner)."""
+        return SimClock(self)
+
     # ----------------------------------------------------------------------------------------
     # Ground truth (evaluation only)
+
+    def report_sections(self, evaluation: Mapping[str, Any]) -> dict[str, Any]:
+        """What a run report gets from the simulator: ``ground_truth`` against the mission's
+        ``evaluation`` references (``goal``, ``reference_path``, ``frame``)."""
+        return {"ground_truth": self.ground_truth_report(
+            goal=evaluation.get("goal"), reference_path=evaluation.get("reference_path"),
+            frame=evaluation.get("frame", "world"))}
 
     def true_pose(self) -> Pose2D:
         """The robot's true pose (evaluation only: never hand this to a behaviour)."""

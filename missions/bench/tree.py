@@ -47,10 +47,10 @@ def _time_runner(mission, ticks: int, *, simulate: bool) -> float:
     else:
         simulation, robot = None, fake_robot()
     options = RunOptions(max_time_s=ticks / mission.rate_hz)
-    clock = ManualClock()
-    runner = Runner(mission, robot, simulation=simulation, clock=clock, options=options)
-    if simulation is None:  # no world to step: advance the manual clock ourselves, no sleeping
-        runner._advance = lambda _started: clock.set(runner.ticks * runner.period)  # noqa: SLF001
+    if simulation is not None:
+        runner = Runner(mission, robot, clock=simulation.clock(), observers=[simulation], options=options)
+    else:  # no world to step: a manual clock jumps from tick to tick, no sleeping
+        runner = Runner(mission, robot, clock=ManualClock(), options=options)
     start = time.perf_counter()
     result = runner.run()
     elapsed = time.perf_counter() - start
@@ -60,7 +60,7 @@ def _time_runner(mission, ticks: int, *, simulate: bool) -> float:
 
 def _time_bare(mission, ticks: int) -> float:
     py_trees.blackboard.Blackboard.clear()
-    task = build_node(mission.tree)
+    task = build_node(mission.tree, mission.registry)
     clock = ManualClock()
     for node in task.iterate():
         node.setup(clock=clock)

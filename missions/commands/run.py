@@ -5,10 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
-from maps.store import Diagnostic, InputError
+from maps.located import validate
+from maps.store import Diagnostic, InputError, output_problem, write_json
 from missions.commands.common import add_mission_options, load_from_args, print_input_error
+from missions.model import RunArguments
 from missions.runner import Runner, RunOptions
+from missions.safety import Interrupted, early_signals, exit_code
 
 DESCRIPTION = """Run a mission until its tree ends in SUCCESS or FAILURE.
 
@@ -16,10 +20,14 @@ Without --robot the mission runs in the built-in simulator (--sim WORLD picks a 
 name or a world file; the default is an empty plane), as fast as the machine allows unless
 --realtime is given. The same seed gives the same run, bit for bit.
 
-Whatever happens (the tree ends, a behaviour raises, Ctrl-C, SIGTERM, --max-time), the base and
-the pan-tilt unit are commanded to stop before the drivers close, and --report is written.
+Whatever happens (the tree ends, a behaviour raises or blocks, Ctrl-C, SIGTERM, --max-time), the
+base and the pan-tilt unit are commanded to stop before the drivers close, and --report is
+written. On a robot, a tick that overruns its period by more than the mission's 'overrun' (1 s by
+default; --overrun S overrides it) makes the watchdog stop the base and end the run; in the
+simulator, where time stands still during a slow tick, the watchdog runs only with --overrun.
 
-exit codes: 0 the mission succeeded, 1 it failed (the report says why), 2 invalid input."""
+exit codes: 0 the mission succeeded, 1 it failed (the report says why), 2 invalid input,
+130/143 interrupted by SIGINT/SIGTERM."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -30,11 +38,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     where.add_argument("--sim", metavar="WORLD", default=None,
                        help="simulate in WORLD (shipped name or world file; default: empty plane)")
     where.add_argument("--robot", metavar="ROBOT.yaml", help="run on the robot described by this profile")
-    parser.add_argument("--seed", type=int, default=0, help="simulator seed (default 0)")
-    parser.add_argument("--report", type=Path, metavar="F.json", help="write the run report (JSON) here")
-    parser.add_argument("--save", type=Path, metavar="F.rrd", help="record the run for the rerun viewer")
+    parser.add_argument("--seed", type=int, default=0, help="simulator seed, 0 to 4294967295 (default 0)")
+    parser.add_argument("--report", type=Path, metavar="F.json",
+                        help="write the run report (JSON) here; a missing folder is created")
+    parser.add_argument("--save", type=Path, metavar="F.rrd",
+                        help="record the run for the rerun viewer; a missing folder is created")
     parser.add_argument("--max-time", type=float, metavar="S", help="FAILURE after S seconds (sim or wall time)")
     parser.add_argument("--rate", type=float, metavar="HZ", help="tick rate (default: the mission's, else 10)")
+    parser.add_argument("--overrun", type=float, metavar="S",
+                        help="how far a tick may overrun its period before the watchdog stops the base")
     parser.add_argument("--realtime", action="store_true", help="pace the simulator at wall-clock speed")
     parser.add_argument("--quiet", action="store_true", help="no progress line")
     parser.add_argument("--debug", action="store_true", help="print the traceback when a behaviour raises")
@@ -43,29 +55,44 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    try:
-        mission = load_from_args(args.mission, args)
-        _check_numbers(args)
-        simulation, robot = _open(args)
-    except InputError as exc:
-        return print_input_error(exc)
+    with early_signals():  # a Ctrl-C while loading still ends with a report and the right exit code
+        try:
+            numbers = _numbers(args)
+            _prepare_outputs(args)
+            mission = load_from_args(args.mission, args)
+            simulation, robot = _open(args, numbers.seed)
+        except InputError as exc:
+            return print_input_error(exc)
+        except Interrupted as exc:
+            return _interrupted_early(args, exc.signum)
+        try:
+            return _run(args, mission, simulation, robot, numbers)
+        finally:
+            robot.close()
+
+
+def _run(args: argparse.Namespace, mission: Any, simulation: Any, robot: Any, numbers: RunArguments) -> int:
     missing = robot.missing_cameras(mission.cameras or ())
     if missing:
-        robot.close()
         where = args.robot or f"world {args.sim or 'empty'}"
         return print_input_error(InputError([Diagnostic(mission.file, 0, 0, f"the mission uses camera(s) "
                                  f"{', '.join(missing)}, which {where} does not have (it has: "
                                  f"{', '.join(robot.cameras) or 'none'})")]))
     options = RunOptions(
-        rate_hz=args.rate, max_time_s=args.max_time, realtime=args.realtime, report_path=args.report,
-        save_path=args.save, progress=not args.quiet and sys.stderr.isatty(), seed=args.seed, debug=args.debug,
-    )
-    try:
-        result = Runner(mission, robot, simulation=simulation, options=options).run()
-    finally:
-        robot.close()
-    clock = "sim" if simulation is not None else "wall"
-    print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock} time, {result.ticks} ticks "
+        rate_hz=numbers.rate, max_time_s=numbers.max_time, overrun_s=numbers.overrun, report_path=args.report,
+        save_path=args.save, progress=not args.quiet and sys.stderr.isatty(), seed=numbers.seed, debug=args.debug,
+    )  # fmt: skip
+    if simulation is not None:
+        from missions.clocks import Paced
+
+        clock = simulation.clock()
+        runner = Runner(mission, robot, clock=Paced(clock) if args.realtime else clock, options=options,
+                        observers=[simulation])
+    else:
+        runner = Runner(mission, robot, options=options)
+    result = runner.run()
+    clock_name = "sim" if simulation is not None else "wall"
+    print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock_name} time, {result.ticks} ticks "
           f"({result.reason})")
     gt = result.report.get("ground_truth")
     if gt:
@@ -79,17 +106,38 @@ def run(args: argparse.Namespace) -> int:
     return result.exit_code
 
 
-def _check_numbers(args: argparse.Namespace) -> None:
+def _numbers(args: argparse.Namespace) -> RunArguments:
+    given = {"--rate": args.rate, "--max-time": args.max_time, "--overrun": args.overrun, "--seed": args.seed}
+    return validate(RunArguments, {k: v for k, v in given.items() if v is not None}, file="command line")
+
+
+def _prepare_outputs(args: argparse.Namespace) -> None:
+    """Check --report and --save before anything runs; create a missing folder (and say so)."""
     problems = []
-    if args.rate is not None and not 0.1 <= args.rate <= 1000:
-        problems.append(Diagnostic("--rate", 0, 0, "must be between 0.1 and 1000 Hz"))
-    if args.max_time is not None and args.max_time <= 0:
-        problems.append(Diagnostic("--max-time", 0, 0, "must be positive"))
+    for option, path in (("--report", args.report), ("--save", args.save)):
+        if path is None:
+            continue
+        folder = path.resolve().parent
+        if not folder.exists() and not output_problem(folder):
+            folder.mkdir(parents=True)
+            print(f"bearings run: created the folder {folder} for {option}", file=sys.stderr)
+        problem = output_problem(path)
+        if problem:
+            problems.append(Diagnostic(f"{option} {path}", 0, 0, problem))
     if problems:
         raise InputError(problems)
 
 
-def _open(args: argparse.Namespace):
+def _interrupted_early(args: argparse.Namespace, signum: int) -> int:
+    reason = "interrupted before the mission started"
+    print(f"{args.mission}: INTERRUPTED ({reason})", file=sys.stderr)
+    if args.report and not output_problem(args.report):
+        write_json(args.report, {"mission": str(args.mission), "status": "INTERRUPTED", "reason": reason,
+                                 "ticks": 0, "wall_time_s": 0.0, "last_command": {"v": 0.0, "w": 0.0}})
+    return exit_code(signum)
+
+
+def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Any]:
     if args.robot:
         from missions.profiles import open_robot
 
@@ -100,8 +148,7 @@ def _open(args: argparse.Namespace):
     from drivers.sim.simulation import Simulation
 
     try:
-        simulation = Simulation.load(args.sim, seed=args.seed)
+        simulation = Simulation.load(args.sim, seed=seed)
     except (OSError, ValueError) as exc:  # InputError (a bad world file) passes through as it is
         raise InputError([Diagnostic(str(args.sim), 0, 0, str(exc))]) from None
     return simulation, simulation.robot
-

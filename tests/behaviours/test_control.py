@@ -8,8 +8,8 @@ from py_trees.common import Status
 
 from behaviours.base import NotSetUp
 from behaviours.composites import RecoveryNode
-from behaviours.decorators import RateController, Timeout, make_guard
-from behaviours.registry import lookup
+from behaviours.decorators import Guard, RateController, Timeout
+from behaviours.registry import Registry
 from behaviours.testing import BehaviourHarness
 
 
@@ -29,6 +29,11 @@ class Scripted(py_trees.behaviour.Behaviour):
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID:
             self.halts += 1
+
+
+def _build(type_name: str, **kwargs):
+    """A built-in control node made the way the builder makes it: its class, by registered name."""
+    return Registry.builtin().lookup(type_name).cls(**kwargs)
 
 
 def test_timeout_uses_the_tree_clock_and_halts_the_child():
@@ -100,7 +105,7 @@ def test_recovery_node_fails_when_recovery_fails_and_waits_while_running():
 
 def test_guard_ticks_child_only_while_condition_holds():
     child = Scripted(Status.RUNNING)
-    harness = BehaviourHarness(make_guard("g", child, "/robot/stalled", "==", False),
+    harness = BehaviourHarness(Guard(name="g", child=child, key="/robot/stalled", op="==", value=False),
                                blackboard={"/robot/stalled": False})
     assert harness.tick() == Status.RUNNING
     harness.write("/robot/stalled", True)
@@ -115,32 +120,32 @@ def test_guard_ticks_child_only_while_condition_holds():
                                                               Status.RUNNING)],
 )
 def test_registered_decorators_map_to_py_trees_semantics(name, params, child_status, expected):
-    node = lookup(name).factory(name=name, child=Scripted(child_status), **params)
+    node = _build(name, name=name, child=Scripted(child_status), **params)
     assert BehaviourHarness(node).tick() == expected
 
 
 def test_retry_gives_up_after_its_attempts():
     child = Scripted(Status.FAILURE)
-    harness = BehaviourHarness(lookup("Retry").factory(name="r", child=child, num_attempts=3))
+    harness = BehaviourHarness(_build("Retry", name="r", child=child, num_attempts=3))
     statuses = [harness.tick() for _ in range(3)]
     assert statuses == [Status.RUNNING, Status.RUNNING, Status.FAILURE] and child.ticks == 3
 
 
 def test_repeat_counts_cycles():
     child = Scripted(Status.SUCCESS)
-    harness = BehaviourHarness(lookup("Repeat").factory(name="r", child=child, num_cycles=3))
+    harness = BehaviourHarness(_build("Repeat", name="r", child=child, num_cycles=3))
     assert [harness.tick() for _ in range(3)] == [Status.RUNNING, Status.RUNNING, Status.SUCCESS]
 
 
 def test_sequence_memory_default_resumes_at_running_child():
     first, second = Scripted(Status.SUCCESS, name="a"), Scripted(Status.RUNNING, name="b")
-    seq = lookup("Sequence").factory(name="s", children=[first, second], memory=True)
+    seq = _build("Sequence", name="s", children=[first, second], memory=True)
     harness = BehaviourHarness(seq)
     harness.tick()
     harness.tick()
     assert (first.ticks, second.ticks) == (1, 2)
     first2, second2 = Scripted(Status.SUCCESS, name="a"), Scripted(Status.RUNNING, name="b")
-    reactive = BehaviourHarness(lookup("Sequence").factory(name="s", children=[first2, second2], memory=False))
+    reactive = BehaviourHarness(_build("Sequence", name="s", children=[first2, second2], memory=False))
     reactive.tick()
     reactive.tick()
     assert (first2.ticks, second2.ticks) == (2, 2)

@@ -110,9 +110,25 @@ def test_stop_and_wait():
 
 
 def test_parameters_are_checked_when_built_by_hand():
-    with pytest.raises(TypeError, match="missing required parameter 'distance'"):
+    with pytest.raises(TypeError, match="missing required input 'distance'"):
         Drive()
     with pytest.raises(ValueError, match=r"Drive.speed must be <= 1.2"):
         Drive(distance=1.0, speed=3.0)
-    with pytest.raises(TypeError, match="unknown parameter"):
+    with pytest.raises(TypeError, match="unknown port"):
         Drive(distance=1.0, sped=0.1)
+    with pytest.raises(ValueError, match="outside the blackboard namespaces"):
+        Drive(distance=1.0, command="{/elsewhere/command}")
+
+
+def test_remapped_ports_read_and_write_other_keys():
+    drive = Drive(distance=1.0, odometry="{/mission/pose}", command="{/mission/velocity}")
+    harness = BehaviourHarness(drive, blackboard={"/mission/pose": Pose2D()})
+    assert harness.tick() == Status.RUNNING
+    assert harness.read("/mission/velocity").v > 0
+    assert harness.read("/robot/command") is None  # the default key is left alone
+
+
+def test_a_wrongly_typed_output_is_a_bug_caught_at_once():
+    drive = Drive(distance=1.0)
+    with pytest.raises(TypeError, match="declared VelocityCommand"):
+        drive.set_output("command", (0.1, 0.0))

@@ -22,7 +22,7 @@ def textured_frame(stamp: float, seed: int = 0) -> Frame:
 
 def test_perceive_publishes_unit_bearings_consistent_with_the_camera():
     frame = textured_frame(1.0)
-    harness = BehaviourHarness(Perceive(max_features=300), blackboard={"/perception/frame": frame})
+    harness = BehaviourHarness(Perceive(max_features=300), blackboard={"/perception/frames": {"panorama": frame}})
     assert harness.tick() == Status.SUCCESS
     observation = harness.read("/perception/observation")
     assert 100 <= observation.count <= 300
@@ -36,12 +36,12 @@ def test_perceive_skips_a_frame_it_has_seen_and_waits_without_frames():
     harness = BehaviourHarness(Perceive())
     assert harness.tick() == Status.SUCCESS
     assert harness.read("/perception/observation") is None
-    harness.write("/perception/frame", textured_frame(1.0))
+    harness.write("/perception/frames", {"panorama": textured_frame(1.0)})
     harness.tick()
     first = harness.read("/perception/observation")
     harness.tick()
     assert harness.read("/perception/observation") is first
-    harness.write("/perception/frame", textured_frame(2.0, seed=1))
+    harness.write("/perception/frames", {"panorama": textured_frame(2.0, seed=1)})
     harness.tick()
     assert harness.read("/perception/observation").stamp == 2.0
 
@@ -51,6 +51,19 @@ def test_perceive_by_camera_name():
     harness = BehaviourHarness(Perceive(camera="right"), blackboard={"/perception/frames": frames})
     harness.tick()
     assert harness.read("/perception/observation").stamp == 4.0
+
+
+def test_two_perceive_nodes_on_two_cameras_write_two_keys():
+    frames = {"left": textured_frame(3.0), "right": textured_frame(4.0, seed=2)}
+    left = BehaviourHarness(Perceive(camera="left", observation="{/perception/left}"),
+                            blackboard={"/perception/frames": frames})
+    left.tick()
+    assert left.read("/perception/left").stamp == 3.0 and left.read("/perception/observation") is None
+    right = BehaviourHarness(Perceive(camera="right", observation="{/perception/right}"))
+    right.write("/perception/frames", frames)
+    right.tick()
+    assert right.read("/perception/right").stamp == 4.0
+    assert right.read("/perception/observation") is None
 
 
 def test_perceive_passes_identified_bearings_through():

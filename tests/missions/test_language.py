@@ -27,13 +27,14 @@ def test_inputs_substitute_with_their_type_and_into_text(write_mission):
               - Drive: {distance: "${side}"}
     """)
     mission = load_mission(path)
-    assert mission.tree.children[0].params["distance"] == 1.5
+    assert mission.tree.children[0].inputs["distance"] == 1.5
     assert mission.values == {"side": 1.5, "label": "corner"}
-    assert load_mission(path, overrides={"side": "3"}).tree.children[0].params["distance"] == 3.0
+    assert load_mission(path, overrides={"side": "3"}).tree.children[0].inputs["distance"] == 3.0
 
 
 def test_references_are_kept_for_tick_time(write_mission):
     path = write_mission("""
+        inputs: {goal_x: 1.5}
         tree:
           Sequence:
             children:
@@ -41,8 +42,8 @@ def test_references_are_kept_for_tick_time(write_mission):
               - CheckBlackboard: {key: /robot/odometry.x, op: ">", value: 0.2}
     """)
     drive_to, check = load_mission(path).tree.children
-    assert drive_to.params["x"] == Ref("/mission/goal_x")
-    assert check.params == {"key": "/robot/odometry.x", "op": ">", "value": 0.2}
+    assert drive_to.inputs["x"] == Ref("/mission/goal_x")
+    assert check.inputs == {"key": "/robot/odometry.x", "op": ">", "value": 0.2}
 
 
 def test_include_with_its_own_inputs_and_name(write_mission, tmp_path):
@@ -66,8 +67,8 @@ def test_include_with_its_own_inputs_and_name(write_mission, tmp_path):
     """)
     mission = load_mission(path)
     first, second = mission.tree.children
-    assert (first.name, first.params["distance"], first.params["speed"]) == ("first leg", 2.0, 0.2)
-    assert (second.params["distance"], second.params["speed"]) == (1.0, 0.5)
+    assert (first.name, first.inputs["distance"], first.inputs["speed"]) == ("first leg", 2.0, 0.2)
+    assert (second.inputs["distance"], second.inputs["speed"]) == (1.0, 0.5)
     assert first.included_from == str((tmp_path / "leg.yaml").resolve())
     assert len(mission.files) == 2
 
@@ -100,13 +101,13 @@ def test_plugin_file_registers_a_behaviour(write_mission, tmp_path):
     (tmp_path / "beep.py").write_text(textwrap.dedent("""
         from py_trees.common import Status
         from behaviours.base import BearingsBehaviour
-        from behaviours.ports import Param
+        from behaviours.ports import InputPort
         from behaviours.registry import register
 
         @register
         class Beep(BearingsBehaviour):
             '''Make a noise (a test plugin).'''
-            PARAMS = (Param("times", "int", 1, doc="how often"),)
+            PORTS = (InputPort("times", int, 1, doc="how often"),)
 
             def update(self):
                 return Status.SUCCESS
@@ -117,8 +118,28 @@ def test_plugin_file_registers_a_behaviour(write_mission, tmp_path):
           Beep: {times: 3}
     """)
     mission = load_mission(path)
-    assert mission.tree.params == {"times": 3}
-    assert registry.lookup("Beep").doc == "Make a noise (a test plugin)."
+    assert mission.tree.inputs == {"times": 3}
+    assert mission.registry.lookup("Beep").doc == "Make a noise (a test plugin)."
+
+
+def test_a_plugin_stays_with_its_mission(write_mission, tmp_path):
+    (tmp_path / "honk.py").write_text(textwrap.dedent("""
+        from py_trees.common import Status
+        from behaviours.base import BearingsBehaviour
+        from behaviours.registry import register
+
+        @register
+        class Honk(BearingsBehaviour):
+            '''Honk (a test plugin).'''
+            def update(self):
+                return Status.SUCCESS
+    """))
+    with_plugin = write_mission("plugins: [honk.py]\ntree: Honk\n", name="a.yaml")
+    without = write_mission("tree: Honk\n", name="b.yaml")
+    assert load_mission(with_plugin).tree.type == "Honk"
+    with pytest.raises(InputError, match="unknown node type 'Honk'"):
+        load_mission(without)  # loaded in the same process, after the first: no leak
+    assert "Honk" not in registry.Registry.default()
 
 
 def test_entry_point_group_registers_behaviours(tmp_path, monkeypatch, write_mission):
@@ -140,17 +161,18 @@ def test_entry_point_group_registers_behaviours(tmp_path, monkeypatch, write_mis
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: acme-bt\nVersion: 1.0\n")
     (info / "entry_points.txt").write_text("[bearings.behaviours]\nacme = acme_bt\n")
     monkeypatch.syspath_prepend(str(package))
-    monkeypatch.setattr(registry, "_entry_points_loaded", False)
+    registry._with_entry_points.cache_clear()
     try:
         mission = load_mission(write_mission("tree: AcmeDock\n"))
         assert mission.tree.type == "AcmeDock"
     finally:
         sys.modules.pop("acme_bt", None)
+        registry._with_entry_points.cache_clear()
 
 
 def test_yaml_12_floats(write_mission):
     path = write_mission("tree:\n  Wait: {duration: 1e-3}\n")
-    assert load_mission(path).tree.params["duration"] == pytest.approx(0.001)
+    assert load_mission(path).tree.inputs["duration"] == pytest.approx(0.001)
 
 
 def test_schema_accepts_every_shipped_mission_and_rejects_typos():

@@ -36,9 +36,9 @@ def test_unknown_parameter(write_mission):
           Drive: {distanse: 1.0}
     """)
     found = problems(path)
-    assert (2, "Drive has no parameter 'distanse'; did you mean 'distance'? (it takes: distance, speed, "
-               "tolerance)") in found
-    assert any("needs parameter 'distance'" in m for _, m in found)
+    assert (2, "Drive has no port 'distanse'; did you mean 'distance'? (it takes: distance, speed, "
+               "tolerance, odometry, stalled, command)") in found
+    assert any("needs input 'distance'" in m for _, m in found)
 
 
 def test_missing_required_parameter(write_mission):
@@ -47,13 +47,13 @@ def test_missing_required_parameter(write_mission):
           Wait: {}
     """)
     [(line, message)] = problems(path)
-    assert line == 2 and "Wait needs parameter 'duration'" in message
+    assert line == 2 and "Wait needs input 'duration'" in message
 
 
 @pytest.mark.parametrize(
     ("value", "expected"),
     [("fast", "expects a number in m/s, got 'fast'"), ("true", "expects a number in m/s, got True"),
-     ("[1, 2]", "expects a number in m/s, got a list"), ("5.0", "must be <= 1.2 in m/s, got 5")],
+     ("[1, 2]", "expects a number in m/s, got a list of 2"), ("5.0", "must be <= 1.2 in m/s, got 5")],
 )
 def test_wrong_type_or_range(write_mission, value, expected):
     path = write_mission(f"""
@@ -76,12 +76,19 @@ def test_bad_blackboard_reference(write_mission):
               - Wait: {duration: "{/robot/odometry}"}
     """)
     found = problems(path)
-    assert (4, "Drive.distance refers to unknown blackboard key '/map/nowhere'") in found
-    assert (5, "Wait.duration refers to /robot/odometry which holds Pose2D, not float") in found
+    assert found == [
+        (4, "Drive.distance reads /map/nowhere, which nothing writes (written keys: /perception/frame, "
+            "/perception/frames, /ptu/state, /robot/command, /robot/odometry, /robot/stalled)"),
+        (5, "Wait.duration is float, but /robot/odometry holds Pose2D (written by the data-gathering branch)"),
+    ]
+    outside = write_mission('tree: {Drive: {distance: "{/elsewhere/x}"}}\n', name="outside.yaml")
+    assert problems(outside) == [(1, "Drive.distance: '/elsewhere/x' is outside the blackboard namespaces "
+                                     "/robot, /ptu, /perception, /map, /mission")]
 
 
 def test_literal_and_reference_are_distinct(write_mission):
     path = write_mission("""
+        inputs: {side: 1.0}
         tree:
           Sequence:
             children:
@@ -90,8 +97,8 @@ def test_literal_and_reference_are_distinct(write_mission):
     """)
     mission = load_mission(path)
     first, second = mission.tree.children
-    assert str(first.params["distance"]) == "{/mission/side}"
-    assert first.params["distance"] == second.params["distance"]
+    assert str(first.inputs["distance"]) == "{/mission/side}"
+    assert first.inputs["distance"] == second.inputs["distance"]
 
 
 def test_unknown_input_in_substitution_and_in_set(write_mission):
@@ -115,7 +122,7 @@ def test_set_value_is_type_checked(write_mission):
     """)
     [(_, message)] = problems(path, overrides={"side": "long"})
     assert message == "input 'side' expects a number, got 'long'"
-    assert load_mission(path, overrides={"side": "2.5"}).tree.params["distance"] == 2.5
+    assert load_mission(path, overrides={"side": "2.5"}).tree.inputs["distance"] == 2.5
 
 
 def test_include_cycle(write_mission):
@@ -208,9 +215,9 @@ def test_node_shape_errors(write_mission):
               - Sequence: {}
     """)
     found = dict(problems(path))
-    assert found[4] == "Drive: parameters are a mapping 'name: value', found 1.0"
+    assert found[4] == "Drive: ports are a mapping 'name: value', found 1.0"
     assert found[5] == "expected a node like 'Drive: {distance: 1.0}', found 42"
-    assert found[6].startswith("a node is one 'TypeName: {parameters}' entry")
+    assert found[6].startswith("a node is one 'TypeName: {ports}' entry")
     assert found[7] == "Inverter decorates one node: use 'child:'"
     assert found[8] == "Stop is a leaf and takes no child"
     assert found[9] == "Sequence needs 'children:', a list of nodes"
@@ -226,16 +233,31 @@ def test_recovery_node_needs_two_children(write_mission):
     assert line == 3 and message == "RecoveryNode takes exactly 2 children, got 1"
 
 
-def test_task_tree_cannot_write_sense_keys(write_mission):
+def test_sensed_keys_keep_a_single_writer(write_mission):
     path = write_mission("""
+        sense:
+          - Perceive: {camera: panorama}
         tree:
           Sequence:
-            children: [ReadOdometry, Stop]
+            children:
+              - Perceive: {camera: front}
+              - Stop: {command: "{/robot/odometry}"}
     """)
-    [(line, message)] = problems(path)
-    assert line == 3 and "ReadOdometry writes /robot/odometry, /robot/stalled, which only the data-gathering" in message
-    ok = write_mission("sense: [ReadOdometry]\ntree: Stop\n", name="ok.yaml")
-    assert load_mission(ok).sense[0].type == "ReadOdometry"
+    found = problems(path)
+    assert (6, "Perceive writes /perception/observation, which Perceive writes too: a sensed key has one writer "
+               "(remap this output to a key of its own, e.g. {/perception/observation_2})") in found
+    assert any(line == 7 and "Stop writes /robot/odometry, which the data-gathering branch writes too" in m
+               for line, m in found)
+    assert any(line == 7 and "Stop writes VelocityCommand to /robot/odometry, where the data-gathering branch "
+               "writes Pose2D" in m for line, m in found)
+    ok = write_mission("""
+        sense:
+          - Perceive: {camera: panorama}
+          - Perceive: {camera: front, observation: "{/perception/front}"}
+        tree: Stop
+    """, name="ok.yaml")
+    assert [n.outputs["observation"] for n in load_mission(ok).sense] == ["/perception/observation",
+                                                                         "/perception/front"]
 
 
 def test_unknown_plugin_module_and_file(write_mission):
@@ -246,14 +268,15 @@ def test_unknown_plugin_module_and_file(write_mission):
     found = problems(path)
     assert (1, "plugin 'no_such_module_xyz' cannot be imported: no module named 'no_such_module_xyz'") in found
     assert (1, "plugin file './missing.py' not found next to the mission") in found
-    assert (1, "plugin 'os; rm -rf /' is neither a module name (a.b.c) nor a .py file") in found
+    assert (1, "plugin 'os; rm -rf /' is neither a module name (a.b.c) nor a .py file in the mission's "
+               "folder") in found
 
 
 def test_top_level_shape(write_mission):
     assert problems(write_mission("- just\n- a list\n")) == [
         (1, "a mission file is a mapping with at least a 'tree:' entry")]
     assert problems(write_mission("mission: nothing\n", name="no_tree.yaml")) == [
-        (1, "the mission has no 'tree:' (the root node of the mission)")]
+        (1, "the file needs 'tree' (the root node of the task tree)")]
 
 
 def test_unsafe_yaml_tags_are_rejected(write_mission):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import pytest
 
 from maps.store import InputError
@@ -28,7 +30,47 @@ def test_profile_shape_errors(tmp_path):
         load_profile(path)
     messages = sorted((d.line, d.message) for d in info.value.diagnostics)
     assert messages == [
-        (2, "base: unknown base driver 'roomba' (known: pioneer)"),
-        (3, "'cameras:' maps camera names to driver settings"),
-        (4, "unknown profile entry 'wheels' (entries: robot, description, base, ptu, cameras)"),
+        (3, "cameras: input should be a valid dictionary, got a list of 1"),
+        (4, "unknown key 'wheels' (allowed: base, cameras, description, ptu, robot)"),
     ]
+    path.write_text("robot: x\nbase: {driver: pionner}\n")
+    with pytest.raises(InputError) as info:
+        load_profile(path)
+    assert [(d.line, d.message) for d in info.value.diagnostics] == [
+        (2, "base: unknown base driver 'pionner'; did you mean 'pioneer'? (known: pioneer)")]
+
+
+def test_driver_settings_are_checked_against_the_opener_declaration(tmp_path, monkeypatch):
+    from pydantic import BaseModel, ConfigDict, Field
+
+    from missions import profiles
+
+    class ToySettings(BaseModel):
+        model_config = ConfigDict(extra="forbid", strict=True)
+        port: str
+        baud: int = Field(9600, ge=1200, le=115200)
+
+    opened = []
+
+    def open_toy(settings: ToySettings):
+        opened.append(settings)
+        from drivers.fake import FakeBase
+
+        return FakeBase()
+
+    open_toy.__annotations__ = {"settings": ToySettings}  # resolved, as in a driver module
+    module = type(sys)("toy_driver")
+    module.ToySettings, module.open_toy = ToySettings, open_toy
+    monkeypatch.setitem(sys.modules, "toy_driver", module)
+    monkeypatch.setitem(profiles.DRIVERS, "base", {"toy": "toy_driver:open_toy"})
+    path = tmp_path / "robot.yaml"
+    path.write_text("base:\n  driver: toy\n  port: /dev/null\n  baud: 3\n  stopbits: 2\n")
+    with pytest.raises(InputError) as info:
+        load_profile(path)
+    assert sorted((d.line, d.message) for d in info.value.diagnostics) == [
+        (4, "base.baud must be >= 1200, got 3"),
+        (5, "unknown key 'stopbits' in base (allowed: baud, port)"),
+    ]
+    path.write_text("base: {driver: toy, port: /dev/null}\n")
+    robot = profiles.open_robot(path)
+    assert opened == [ToySettings(port="/dev/null")] and robot.name == "robot"

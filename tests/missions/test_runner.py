@@ -10,6 +10,7 @@ import textwrap
 
 import pytest
 
+from behaviours.clock import ManualClock
 from drivers.fake import fake_robot
 from drivers.sim.simulation import Simulation
 from missions.cli import main
@@ -79,8 +80,7 @@ def test_exception_in_a_behaviour_is_a_failure_with_a_reason_and_a_stop(write_mi
             - Boom
     """, plugins="[./boom.py]")
     robot = fake_robot()
-    result = Runner(mission, robot, options=RunOptions(report_path=tmp_path / "r.json"),
-                    simulation=_NoWorld()).run()
+    result = Runner(mission, robot, options=RunOptions(report_path=tmp_path / "r.json"), clock=ManualClock()).run()
     assert result.status == "FAILURE"
     assert result.reason == "Boom (Boom) raised ZeroDivisionError: the flux capacitor"
     assert any(v > 0 for v, _ in robot.base.commands)  # it was driving ...
@@ -98,7 +98,7 @@ def test_failure_of_the_tree_stops_the_robot(write_mission):
                 child: {Drive: {distance: 10.0}}
     """)
     robot = fake_robot()
-    result = Runner(mission, robot, simulation=_NoWorld()).run()
+    result = Runner(mission, robot, clock=ManualClock()).run()
     assert result.status == "FAILURE" and result.ticks == 11
     assert "timed out after 1 s" in result.reason
     assert robot.base.commands[-1] == (0.0, 0.0)
@@ -113,27 +113,28 @@ def test_sigterm_stops_the_robot_and_reports(write_mission, tmp_path):
             os.kill(os.getpid(), signal.SIGTERM)
 
     previous = signal.getsignal(signal.SIGTERM)
-    result = Runner(mission, robot, simulation=_NoWorld(), on_tick=terminate_at_tick_5,
+    result = Runner(mission, robot, clock=ManualClock(), on_tick=terminate_at_tick_5,
                     options=RunOptions(report_path=tmp_path / "r.json")).run()
-    assert result.status == "FAILURE" and result.reason == "interrupted by SIGTERM"
-    assert result.ticks == 5
+    assert result.status == "INTERRUPTED" and result.reason == "interrupted by SIGTERM"
+    assert result.ticks == 5 and result.exit_code == 143
     assert robot.base.commands[-1] == (0.0, 0.0)
     assert signal.getsignal(signal.SIGTERM) is previous  # handlers restored
-    assert json.loads((tmp_path / "r.json").read_text())["status"] == "FAILURE"
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["status"] == "INTERRUPTED" and report["last_command"] == {"v": 0.0, "w": 0.0}
 
 
 def test_a_dead_sensor_fails_the_mission_and_stops(write_mission):
     mission = _mission(write_mission, "Drive: {distance: 1.0}\n")
     robot = fake_robot()
     robot.base.fail_on_odometry = OSError("serial port vanished")
-    result = Runner(mission, robot, simulation=_NoWorld()).run()
+    result = Runner(mission, robot, clock=ManualClock()).run()
     assert result.reason == "ReadOdometry (ReadOdometry) raised OSError: serial port vanished"
     assert robot.base.commands == [(0.0, 0.0)]
 
 
 def test_max_time_is_a_failure(write_mission):
     mission = _mission(write_mission, "Wait: {duration: 100.0}\n")
-    result = Runner(mission, fake_robot(), simulation=_NoWorld(), options=RunOptions(max_time_s=2.0)).run()
+    result = Runner(mission, fake_robot(), clock=ManualClock(), options=RunOptions(max_time_s=2.0)).run()
     assert result.status == "FAILURE" and result.reason == "time limit of 2 s reached"
     assert result.ticks == 20
 
@@ -146,7 +147,7 @@ def test_commands_do_not_outlive_their_tick(write_mission):
             - Wait: {duration: 0.5}
     """)
     sim = Simulation.load(None, seed=0)
-    Runner(mission, sim.robot, simulation=sim).run()
+    Runner(mission, sim.robot, clock=sim.clock(), observers=[sim]).run()
     commands = sim.robot.base.commands
     moving = [i for i, (_, v, _w) in enumerate(commands) if v != 0.0]
     assert moving and all(v == 0.0 for _, v, _w in commands[moving[-1] + 1:])
@@ -189,19 +190,6 @@ def test_reactive_composites_export_as_reactive(write_mission, capsys):
     assert "<ReactiveFallback>" in capsys.readouterr().out
 
 
-class _NoWorld:
-    """A stand-in simulation with no world: only time passes (for runs on fake drivers)."""
-
-    def step(self, dt: float) -> None:
-        pass
-
-    def ground_truth_report(self, **_kwargs) -> dict:
-        return {}
-
-    def log_rerun(self, rr) -> None:
-        pass
-
-
 def test_showcase_in_the_lab_is_deterministic_on_rendered_pixels(tmp_path):
     def run(name: str) -> dict:
         path = tmp_path / f"{name}.json"
@@ -227,7 +215,7 @@ def test_a_mission_needing_a_camera_the_world_lacks_is_invalid(write_mission, ca
 def test_runner_refuses_a_missing_camera_at_setup_before_any_motion(write_mission):
     mission = load_mission(write_mission("cameras: [periscope]\ntree: {Drive: {distance: 1.0}}\n"))
     robot = fake_robot(cameras=("front",))
-    result = Runner(mission, robot, simulation=_NoWorld()).run()
+    result = Runner(mission, robot, clock=ManualClock()).run()
     assert result.status == "FAILURE" and result.ticks == 0
     assert "has no camera periscope (it has: front)" in result.reason
     assert robot.base.commands == [(0.0, 0.0)]

@@ -78,14 +78,15 @@ def test_every_error_of_a_file_is_reported_with_its_line_and_column(world_file) 
     found = _errors(exc)
     text = str(exc.value)
     expected = {
-        3: "a point must be [x, y]",
-        4: "wall height must be > 0",
-        6: "a pillar needs 'height'",
-        8: "landmark position must be a list of 3 numbers",
+        3: "walls[0].points[1] must have at least 2 items, got 1",
+        4: "walls[0].height must be > 0 m, got -2",
+        6: "pillars[0] needs 'height'",
+        8: "landmarks[0].position must have at least 3 items, got 2",
         9: "duplicate landmark id 1",
-        11: "unknown camera kind 'fisheye'",
-        12: "focal lengths must be positive",
-        13: "start y must be a finite number",
+        11: "cameras[0].kind must be one of 'bearings', 'panorama', 'catadioptric', 'pinhole' or 'stereo', got "
+            "'fisheye'",
+        12: "cameras[1]: focal lengths must be positive",
+        13: "start.y expects a finite number in m, got 'two'",
         14: "unknown key 'ceilling'",
     }
     for line, fragment in expected.items():
@@ -97,14 +98,14 @@ def test_every_error_of_a_file_is_reported_with_its_line_and_column(world_file) 
 @pytest.mark.parametrize(
     ("text", "line", "fragment"),
     [
-        ("walls: {points: [[0, 0], [1, 0]]}\n", 1, "walls must be a list"),
+        ("walls: {points: [[0, 0], [1, 0]]}\n", 1, "walls: input should be a valid list"),
         ("walls:\n  - {points: [[0, 0], [0, 0]], height: 1}\n", 2, "zero-length wall"),
         ("boxes:\n  - {center: [0, 0], size: [1, 0], height: 1}\n", 2, "box size must be positive"),
         ("ptu: {tilt_limits_deg: [30, -40]}\n", 1, "the first limit must be below the second"),
-        ("cameras:\n  - {name: a, kind: panorama, mount: wrist}\n", 2, "mount must be one of"),
+        ("cameras:\n  - {name: a, kind: panorama, mount: wrist}\n", 2, "mount must be one of 'base' or 'ptu'"),
         ("cameras:\n  - {name: a, kind: panorama, noise_deg: 1}\n", 2, "only applies to a bearings sensor"),
         ("ceiling: 0.5\n", 1, "is not below the ceiling"),
-        ("format: 7\n", 1, "unsupported world format"),
+        ("format: 7\n", 1, "format must be one of 1, got 7"),
         ("- just a list\n", 1, "a world file must be a mapping"),
         ("walls: [\n", 2, "malformed YAML"),
     ],
