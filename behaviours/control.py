@@ -133,21 +133,21 @@ class OneShot(Declared, py_trees.decorators.OneShot):
 
 
 @register
-class Success(Declared, py_trees.behaviours.Success):
+class Success(Declared, py_trees.behaviours.Success):  # type: ignore[valid-type,misc]
     """Always SUCCESS."""
 
     BTCPP = "AlwaysSuccess"
 
 
 @register
-class Failure(Declared, py_trees.behaviours.Failure):
+class Failure(Declared, py_trees.behaviours.Failure):  # type: ignore[valid-type,misc]
     """Always FAILURE."""
 
     BTCPP = "AlwaysFailure"
 
 
 @register
-class Running(Declared, py_trees.behaviours.Running):
+class Running(Declared, py_trees.behaviours.Running):  # type: ignore[valid-type,misc]
     """Always RUNNING."""
 
     BTCPP = "AlwaysRunning"

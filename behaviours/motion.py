@@ -10,11 +10,12 @@ instead of overshooting.
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.ports import InputPort, OutputPort, Port, Ref
 from behaviours.registry import register
 from drivers.interfaces import STOP, VelocityCommand
 from perception.geometry import Pose2D, wrap_angle
@@ -36,11 +37,11 @@ ODOMETRY = InputPort("odometry", Pose2D, Ref("/robot/odometry"), doc="the base's
 STALLED = InputPort("stalled", bool, Ref("/robot/stalled"), doc="a wheel is stalled: stop and fail")
 COMMAND = OutputPort("command", VelocityCommand, "/robot/command", unit="m/s, rad/s",
                      doc="the velocity for this tick (the runner sends it to the base)")
-MOTION_PORTS = (ODOMETRY, STALLED, COMMAND)
+MOTION_PORTS: tuple[Port, ...] = (ODOMETRY, STALLED, COMMAND)
 
 
 class _OdometryMotion(BearingsBehaviour):
-    PORTS = MOTION_PORTS
+    PORTS: ClassVar[tuple[Port, ...]] = MOTION_PORTS
 
     def odometry(self) -> Pose2D | None:
         return self.get_input("odometry", None)

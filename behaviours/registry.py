@@ -81,7 +81,7 @@ class NodeType:
     def of(cls, node_cls: type) -> NodeType:
         """The node type a class declares; ``ValueError`` when the declaration is malformed."""
         name = node_cls.__name__
-        kind = getattr(node_cls, "KIND", "action")
+        kind: Kind = getattr(node_cls, "KIND", "action")
         ports = tuple(getattr(node_cls, "PORTS", ()))
         low, high = getattr(node_cls, "CHILDREN", (0, 0))
         problems = _declaration_problems(name, kind, ports, low, high)
@@ -105,7 +105,8 @@ class NodeType:
 
     @property
     def ports(self) -> dict[str, Port]:
-        return {p.name: p for p in (*self.inputs, *self.outputs)}
+        declared: list[Port] = [*self.inputs, *self.outputs]
+        return {p.name: p for p in declared}
 
     def build(self, *, name: str, children: list[py_trees.behaviour.Behaviour], ports: dict[str, Any]
               ) -> py_trees.behaviour.Behaviour:

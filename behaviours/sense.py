@@ -27,9 +27,10 @@ class _Sensor(BearingsBehaviour):
 
     @property
     def robot(self) -> Robot:
-        if getattr(self, "_robot", None) is None:
+        robot = getattr(self, "_robot", None)
+        if robot is None:
             raise NotSetUp(f"{self.name}: no robot; set the tree up with setup(robot=...)")
-        return self._robot
+        return robot
 
 
 class ReadOdometry(_Sensor):
@@ -77,10 +78,11 @@ class GrabFrames(_Sensor):
 
     def setup(self, **kwargs: Any) -> None:
         super().setup(**kwargs)
-        if self.only is not None and getattr(self, "_robot", None) is not None:
-            missing = self._robot.missing_cameras(self.only)
+        robot = getattr(self, "_robot", None)
+        if self.only is not None and robot is not None:
+            missing = robot.missing_cameras(self.only)
             if missing:
-                have = ", ".join(self._robot.cameras) or "none"
+                have = ", ".join(robot.cameras) or "none"
                 raise KeyError(f"the robot has no camera {', '.join(missing)} (it has: {have})")
 
     def update(self) -> Status:

@@ -11,7 +11,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
-from perception.frame import Frame
+from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
 
 
@@ -92,8 +92,8 @@ class Camera(Protocol):
 
     name: str
 
-    def grab(self) -> Frame | None:
-        """The newest frame, or None when the camera dropped it."""
+    def grab(self) -> Frame | LandmarkBearings | None:
+        """The newest frame (identified bearings from an ideal sensor), or None when the camera dropped it."""
 
     def close(self) -> None:
         """Release the device."""

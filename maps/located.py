@@ -33,10 +33,16 @@ FILE_MODEL_CONFIG = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False,
 """The configuration every declared file model uses (unknown keys are errors, no coercion)."""
 
 
+def closest(word: Any, options: Iterable[Any]) -> str | None:
+    """The option most like ``word`` (a likely typo of it), or None."""
+    close = difflib.get_close_matches(str(word), [str(o) for o in options], n=1, cutoff=0.6)
+    return close[0] if close else None
+
+
 def suggest(word: Any, options: Iterable[Any]) -> str:
     """``"; did you mean 'x'?"`` for the closest option, or an empty string."""
-    close = difflib.get_close_matches(str(word), [str(o) for o in options], n=1, cutoff=0.6)
-    return f"; did you mean {close[0]!r}?" if close else ""
+    match = closest(word, options)
+    return f"; did you mean {match!r}?" if match else ""
 
 
 def describe_value(value: Any) -> str:
@@ -68,8 +74,9 @@ def diagnose(exc: ValidationError, data: Any, *, file: str, model: type[BaseMode
     out = []
     for error in exc.errors(include_url=False):
         mark, steps = _locate(data, error["loc"], key_mark=error["type"] == "extra_forbidden")
-        field, allowed = _field(model, error["loc"])
-        out.append(Diagnostic(file, mark.line, mark.col, _message(error, [*path, *steps], field, allowed)))
+        field, allowed, annotation = _field(model, error["loc"])
+        out.append(Diagnostic(file, mark.line, mark.col,
+                              _message(error, [*path, *steps], field, allowed, _unit(field, annotation))))
     return sorted(set(out), key=lambda d: (d.line, d.col, d.message))
 
 
@@ -79,7 +86,8 @@ def _locate(data: Any, loc: tuple[Any, ...], *, key_mark: bool) -> tuple[Mark, l
 
     Elements of ``loc`` that are not in the data (pydantic's union tags) are skipped.
     """
-    node, mark, path = data, mark_of(data, Mark(1, 1)), []
+    located = isinstance(data, (YamlMap, YamlList))
+    node, mark, path = data, mark_of(data, Mark(1, 1) if located else Mark(0, 0)), []
     for index, step in enumerate(loc):
         last = index == len(loc) - 1
         if isinstance(node, YamlMap) and step in node:
@@ -87,6 +95,8 @@ def _locate(data: Any, loc: tuple[Any, ...], *, key_mark: bool) -> tuple[Mark, l
             node = node[step]
         elif isinstance(node, YamlList) and isinstance(step, int) and 0 <= step < len(node):
             mark, node = node.mark_of(step), node[step]
+        elif isinstance(node, dict) and step in node:  # plain data (command-line values): no marks
+            node = node[step]
         elif isinstance(node, (dict, list)) or isinstance(step, int):
             continue  # a union tag, or a missing key: stay at the container
         else:
@@ -103,10 +113,9 @@ def _where(path: list[Any]) -> str:
 
 
 # -- what ------------------------------------------------------------------------------------------
-def _message(error: Any, path: list[Any], field: FieldInfo | None, allowed: list[str]) -> str:
+def _message(error: Any, path: list[Any], field: FieldInfo | None, allowed: list[str], unit: str) -> str:
     kind, loc, ctx = error["type"], error["loc"], error.get("ctx", {})
     where, given = _where(path), error.get("input")
-    unit = _unit(field)
     if kind == "extra_forbidden":
         key = loc[-1]
         inside = f" in {_where(path[:-1])}" if len(path) > 1 else ""
@@ -148,15 +157,27 @@ def _lower(text: str) -> str:
     return text[:1].lower() + text[1:]
 
 
-def _unit(field: FieldInfo | None) -> str:
-    extra = field.json_schema_extra if field is not None else None
-    unit = extra.get("unit") if isinstance(extra, dict) else None
-    return f" {unit}" if unit else ""
+def _unit(field: FieldInfo | None, annotation: Any) -> str:
+    """The declared unit of the value: on the field, or on the annotated type it holds."""
+    infos = [field] if field is not None else []
+    pending = [annotation]
+    while pending:
+        tp = pending.pop()
+        if typing.get_origin(tp) is typing.Annotated:
+            infos += [m for m in typing.get_args(tp)[1:] if isinstance(m, FieldInfo)]
+            pending.append(typing.get_args(tp)[0])
+        elif typing.get_origin(tp) in (Union, types.UnionType):
+            pending += list(typing.get_args(tp))
+    for info in infos:
+        extra = info.json_schema_extra
+        if isinstance(extra, dict) and extra.get("unit"):
+            return f" {extra['unit']}"
+    return ""
 
 
 # -- the declaration at a path ---------------------------------------------------------------------
-def _field(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> tuple[FieldInfo | None, list[str]]:
-    """The field declared at ``loc`` and the field names of the model that holds it."""
+def _field(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> tuple[FieldInfo | None, list[str], Any]:
+    """The field declared at ``loc``, the field names of the model that holds it, and the type at ``loc``."""
     current: Any = model
     field: FieldInfo | None = None
     allowed: list[str] = []
@@ -164,17 +185,25 @@ def _field(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> tuple[FieldIn
         models = _models_in(current)
         if isinstance(step, int) or not models:
             current = _item_type(current)
+            field = None if isinstance(step, int) else field  # an item of a list has its own declaration
             continue
-        holder = next((m for m in models if step in m.model_fields), None)
+        holder = next((m for m in models if _named(m, step) is not None), None)
         if holder is None:
             tagged = [m for m in models if _tag_of(m) == step]
             current = tagged[0] if tagged else current
             allowed = sorted(models[0].model_fields) if not tagged else allowed
             continue
         allowed = sorted(holder.model_fields)
-        field = holder.model_fields[step]
-        current = field.annotation
-    return field, allowed
+        field = _named(holder, step)
+        current = field.annotation if field is not None else None
+    return field, allowed, current
+
+
+def _named(model: type[BaseModel], step: Any) -> FieldInfo | None:
+    """A model's field by its name or its alias (command-line options are aliases: ``--rate``)."""
+    if step in model.model_fields:
+        return model.model_fields[step]
+    return next((f for f in model.model_fields.values() if f.alias == step), None)
 
 
 def _models_in(tp: Any) -> list[type[BaseModel]]:
@@ -194,6 +223,8 @@ def _item_type(tp: Any) -> Any:
         return _item_type(inner[0]) if len(inner) == 1 else tp
     if origin in (list, tuple) and args:
         return args[0]
+    if origin is None and isinstance(tp, type) and issubclass(tp, (list, dict)):
+        return Any
     if origin is dict and len(args) == 2:
         return args[1]
     return tp

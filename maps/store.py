@@ -100,19 +100,24 @@ def _mark(node: yaml.Node) -> Mark:
 
 
 _PLAIN_TAGS = ("tag:yaml.org,2002:map", "tag:yaml.org,2002:seq")
-MAX_NODES = 200_000  # guards against alias bombs ("billion laughs") and absurd files
+MAX_NODES = 200_000  # values beyond what the text itself can hold: guards against alias bombs ("billion laughs")
+MAX_FILE_BYTES = 16 * 1024 * 1024  # a mission, world, profile or calibration file is kilobytes, not gigabytes
 
 
 class _Budget:
-    def __init__(self, file: str) -> None:
-        self.left = MAX_NODES
+    """How many values a document may expand to: its length (a value takes at least two characters
+    of text) plus a margin; only aliases expanding over and over can exceed it."""
+
+    def __init__(self, file: str, text_length: int) -> None:
+        self.total = MAX_NODES + text_length // 2
+        self.left = self.total
         self.file = file
 
     def spend(self, node: yaml.Node) -> None:
         self.left -= 1
         if self.left < 0:
-            raise InputError([Diagnostic(self.file, *_pos(node), f"more than {MAX_NODES} YAML values "
-                                         "(an alias expanding too often?)")])
+            raise InputError([Diagnostic(self.file, *_pos(node), f"more than {self.total} YAML values in "
+                                         "the document: an alias expands too often")])
 
 
 def _construct(node: yaml.Node, loader: _SafeLoader, file: str, budget: _Budget) -> Any:
@@ -138,7 +143,11 @@ def _construct(node: yaml.Node, loader: _SafeLoader, file: str, budget: _Budget)
         items = YamlList(_construct(child, loader, file, budget) for child in node.value)
         items.mark, items.item_marks = _mark(node), [_mark(child) for child in node.value]
         return items
-    return loader.construct_object(node, deep=True)
+    try:
+        return loader.construct_object(node, deep=True)
+    except (ValueError, TypeError, OverflowError) as exc:  # an explicit tag on a value it cannot hold
+        raise InputError([Diagnostic(file, *_pos(node), f"malformed YAML: {node.value!r} cannot be read as "
+                                     f"{node.tag.rsplit(':', 1)[-1]} ({type(exc).__name__})")]) from None
 
 
 def _pos(node: yaml.Node) -> tuple[int, int]:
@@ -153,7 +162,7 @@ def parse_yaml(text: str, *, file: str = "<string>") -> Any:
         node = loader.get_single_node()
         if node is None:
             raise InputError([Diagnostic(file, 1, 1, "the file is empty")])
-        return _construct(node, loader, file, _Budget(file))
+        return _construct(node, loader, file, _Budget(file, len(text)))
     except yaml.reader.ReaderError as exc:
         line = text.count("\n", 0, exc.position) + 1
         col = exc.position - (text.rfind("\n", 0, exc.position) + 1) + 1
@@ -177,13 +186,17 @@ def read_text(path: str | os.PathLike) -> str:
     """Read a UTF-8 text file named by the user; clear :class:`InputError` on any failure."""
     name = str(path)
     try:
-        data = Path(path).read_bytes()
+        with open(path, "rb") as handle:  # bounded: /dev/zero or a 300 MB line must not fill memory
+            data = handle.read(MAX_FILE_BYTES + 1)
     except FileNotFoundError:
         raise InputError([Diagnostic(name, 0, 0, "no such file")]) from None
     except IsADirectoryError:
         raise InputError([Diagnostic(name, 0, 0, "is a directory, not a file")]) from None
     except OSError as exc:
         raise InputError([Diagnostic(name, 0, 0, f"cannot read: {exc.strerror}")]) from None
+    if len(data) > MAX_FILE_BYTES:
+        raise InputError([Diagnostic(name, 0, 0, f"larger than {MAX_FILE_BYTES // (1024 * 1024)} MB: not a "
+                                     "mission, world or profile file")])
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:

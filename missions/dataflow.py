@@ -27,7 +27,7 @@ from behaviours.keys import COMMAND_KEYS, input_key
 from behaviours.ports import InputPort, Key, Ref, assignable, attribute_type, type_name
 from behaviours.registry import NodeType
 from behaviours.sense import SENSE_NODES
-from maps.located import suggest
+from maps.located import closest
 from maps.store import Diagnostic
 from missions.language import Location, MissionSpec, NodeSpec
 
@@ -71,15 +71,15 @@ def _writers(mission: MissionSpec) -> dict[str, list[Writer]]:
     for cls in SENSE_NODES:
         for port in NodeType.of(cls).outputs:
             out.setdefault(port.key, []).append(Writer(port.key, port.type, "the data-gathering branch", here, True))
-    for name, port in mission.inputs.items():
+    for name, declared in mission.inputs.items():
         key = input_key(name)
-        out.setdefault(key, []).append(Writer(key, port.type, f"the mission input {name!r}", here))
+        out.setdefault(key, []).append(Writer(key, declared.type, f"the mission input {name!r}", here))
     for sensed, roots in ((True, mission.sense), (False, (mission.tree,))):
         for spec in (node for root in roots for node in root.walk()):
             node_type = mission.registry.lookup(spec.type)
-            for port in node_type.outputs if node_type else ():
-                key = spec.outputs[port.name]
-                out.setdefault(key, []).append(Writer(key, port.type, _who(spec), spec.where(port.name), sensed))
+            for output in node_type.outputs if node_type else ():
+                key = spec.outputs[output.name]
+                out.setdefault(key, []).append(Writer(key, output.type, _who(spec), spec.where(output.name), sensed))
     return out
 
 
@@ -136,7 +136,10 @@ def _reads(mission: MissionSpec) -> list[Read]:
 
 
 def _unwritten(read: Read, writers: dict[str, list[Writer]]) -> Diagnostic:
-    hint = suggest(read.key, writers) or f" (written keys: {', '.join(sorted(writers))})"
+    namespace, _, leaf = read.key.rpartition("/")
+    siblings = {key.rpartition("/")[2]: key for key in writers if key.rpartition("/")[0] == namespace}
+    match = closest(leaf, siblings)  # names within the namespace: a shared prefix is no likeness
+    hint = f"; did you mean {siblings[match]!r}?" if match else f" (written keys: {', '.join(sorted(writers))})"
     return _at(read.node.where(read.port.name), f"{_who(read.node)}.{read.port.name} reads {read.key}, which "
                f"nothing writes{hint}")
 

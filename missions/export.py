@@ -90,7 +90,8 @@ def btcpp_xml(mission: MissionSpec) -> str:
         if tag in BTCPP_BUILTIN:
             continue
         element = ET.SubElement(model, BTCPP_MODEL_TAG[node_type.kind], {"ID": tag})
-        for port in (*node_type.inputs, *node_type.outputs):
+        ports: list[InputPort | OutputPort] = [*node_type.inputs, *node_type.outputs]
+        for port in ports:
             _model_port(element, port)
     ET.indent(root)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
@@ -113,29 +114,42 @@ def _model_port(element: ET.Element, port: InputPort | OutputPort) -> None:
     ET.SubElement(element, tag, attrs).text = port.doc + (f" [{port.unit}]" if port.unit else "")
 
 
+def _reactive(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
+    return (tag if params.pop("memory", True) else "Reactive" + tag), {}
+
+
+def _timeout(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
+    return tag, {"msec": str(round(params.pop("duration") * 1000))}
+
+
+def _parallel(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
+    policy, _ = params.pop("policy"), params.pop("synchronise")
+    count = len(node.children) if policy == "all" else 1
+    return tag, {"success_count": str(count), "failure_count": "1"}
+
+
+def _run_once(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
+    params.pop("policy")
+    return tag, {"then_skip": "true"}
+
+
+def _precondition(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
+    key, op, value = params.pop("key"), params.pop("op"), params.pop("value")
+    return tag, {"if": f"{{{key}}} {op} {format_literal(value)}", "else": "FAILURE"}
+
+
+# Where a bearings control node's ports differ from its BT.CPP counterpart's attributes.
+_TRANSLATE = {"Sequence": _reactive, "Selector": _reactive, "Timeout": _timeout, "Parallel": _parallel,
+              "OneShot": _run_once, "Guard": _precondition}
+
+
 def _xml_node(node: NodeSpec, used: dict[str, NodeType], registry: Registry) -> ET.Element:
     node_type = registry.lookup(node.type)
     if node_type is None:
         raise ValueError(f"unknown node type {node.type!r}")
-    tag = node_type.btcpp
-    attrs: dict[str, str] = {}
     params: dict[str, Any] = dict(node.inputs)
-    if node.type in ("Sequence", "Selector"):
-        if not params.pop("memory", True):
-            tag = "Reactive" + tag
-    elif node.type == "Timeout":
-        attrs["msec"] = str(round(params.pop("duration") * 1000))
-    elif node.type == "Parallel":
-        policy, _ = params.pop("policy"), params.pop("synchronise")
-        count = len(node.children) if policy == "all" else 1
-        attrs.update(success_count=str(count), failure_count="1")
-    elif node.type == "OneShot":
-        attrs["then_skip"] = "true"
-        params.pop("policy")
-    elif node.type == "Guard":
-        key, op, value = params.pop("key"), params.pop("op"), params.pop("value")
-        attrs["if"] = f"{{{key}}} {op} {format_literal(value)}"
-        attrs["else"] = "FAILURE"
+    translate = _TRANSLATE.get(node.type)
+    tag, attrs = translate(node, params, node_type.btcpp) if translate else (node_type.btcpp, {})
     for key, value in params.items():
         if value is not None:
             attrs[key] = format_literal(value)

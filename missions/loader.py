@@ -130,7 +130,9 @@ class _Loader:
     def take_plugins(self, doc: _Document) -> None:
         """Add the node types of the modules a mission lists under ``plugins:`` to this load's registry."""
         raw = doc.data.get("plugins")
-        for index, module in enumerate(doc.header.plugins if isinstance(raw, YamlList) else ()):
+        if not isinstance(raw, YamlList):
+            return  # absent, or already reported by the top-level check
+        for index, module in enumerate(doc.header.plugins):
             try:
                 self.plugins.append(load_plugin(module, doc.path.parent, self.registry))
             except PluginError as exc:

@@ -9,6 +9,7 @@ the node types' declared ports.
 
 from __future__ import annotations
 
+import typing
 from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Field
@@ -23,7 +24,8 @@ MaxTime = Annotated[float, Field(gt=0.0, le=1e7, description="time limit (simula
 Overrun = Annotated[float, Field(gt=0.0, le=60.0, description="how far a tick may overrun its period before the "
                                  "watchdog stops the base", json_schema_extra={"unit": "s"})]
 Seed = Annotated[int, Field(ge=0, le=2**32 - 1, description="simulator seed")]
-TypeName = Literal[tuple(TYPE_NAMES)]  # type: ignore[valid-type]
+TypeName = Literal["float", "int", "bool", "str", "key", "list[float]", "any"]
+assert set(typing.get_args(TypeName)) == set(TYPE_NAMES), "the mission input types are declared in behaviours.ports"
 
 
 class InputDeclaration(BaseModel):

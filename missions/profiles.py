@@ -162,8 +162,9 @@ def profile_schema() -> dict[str, Any]:
         for driver, target in drivers.items():
             _, settings_model = _opener(target)
             if settings_model is not None:
+                tag: Any = Literal[driver]
                 variants.append(create_model(f"{settings_model.__name__}Entry", __base__=settings_model,
-                                             driver=(Literal[driver], Field(description="the driver"))))
+                                             driver=(tag, Field(description="the driver"))))
         roles[role] = typing.Union[tuple(variants)] if variants else DeviceEntry  # noqa: UP007 - built at run time
     base, ptu, camera = roles["base"], roles["ptu"], roles["camera"]
     model = create_model("RobotProfileSchema", __base__=RobotProfile, base=(base, ...), ptu=(ptu | None, None),

@@ -264,8 +264,8 @@ class Runner:
 
     def _print_progress(self, now: float) -> None:
         tip = self.task.tip()
-        active = f"{tip.name}" + (f": {tip.feedback_message}" if tip is not None and tip.feedback_message else "")
-        line = f"[{self.mission.name}] t={now:7.1f} s  tick {self.ticks:6d}  {active if tip else ''}"
+        active = "" if tip is None else tip.name + (f": {tip.feedback_message}" if tip.feedback_message else "")
+        line = f"[{self.mission.name}] t={now:7.1f} s  tick {self.ticks:6d}  {active}"
         sys.stderr.write("\r" + line[:110].ljust(110))
         sys.stderr.flush()
 

@@ -121,10 +121,14 @@ class SafetyMonitor:
         self._wake_r, self._wake_w = os.pipe()
         os.set_blocking(self._wake_w, False)
         previous_fd = signal.set_wakeup_fd(self._wake_w, warn_on_full_buffer=False)
-        self._restore.append(lambda: signal.set_wakeup_fd(previous_fd))
-        for sig in SIGNALS:
-            previous = signal.signal(sig, self._on_signal)
-            self._restore.append(lambda sig=sig, previous=previous: signal.signal(sig, previous))
+        previous = {sig: signal.signal(sig, self._on_signal) for sig in SIGNALS}
+
+        def restore() -> None:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+            signal.set_wakeup_fd(previous_fd)
+
+        self._restore.append(restore)
 
     def _on_signal(self, signum: int, _frame: FrameType | None) -> None:
         first = self.signum is None

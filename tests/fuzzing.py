@@ -2,12 +2,18 @@
 
 from __future__ import annotations
 
+import os
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from maps.store import InputError
+
+
+def examples(count: int) -> int:
+    """How many examples a fuzz test draws: ``count`` in the suite, 20x with HYPOTHESIS_PROFILE=fuzz."""
+    return count * 20 if os.environ.get("HYPOTHESIS_PROFILE") == "fuzz" else count
 
 
 def load_or_diagnose(data: bytes, load: Callable[[Path], Any], *, name: str = "input.yaml") -> Any:

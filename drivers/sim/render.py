@@ -105,6 +105,7 @@ class PanoramaRenderer:
     def render(self, x: float, y: float, psi: float) -> np.ndarray:
         """The grey image seen from (x, y, eye_z) with the grid's azimuth 0 pointing at ``psi``."""
         mx, my = self.atlas_map(x, y, psi)
+        assert self.scene.atlas is not None, "the renderer builds the scene's textures when it is made"
         image = cv2.remap(self.scene.atlas, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
         if self.draw_landmarks:
             self.draw_landmarks_on(image, x, y, psi)
@@ -130,6 +131,7 @@ class PanoramaRenderer:
                 np.matmul(rows, coef, out=my[r0:r1])
             else:  # floor or ceiling: texel of the world point at distance r along the column
                 region = scene.floor_region if kind == 0 else scene.ceiling_region
+                assert region is not None, "a ceiling band exists only under a ceiling"
                 fx0, fy0 = scene.floor_origin
                 p = region.pixels_per_m
                 coef[0] = dirs[:, 0] * p
@@ -283,6 +285,7 @@ class CameraRenderer:
             self._cache.move_to_end(key)
             return hit
         level = np.allclose(rest, np.eye(3), atol=1e-12)
+        entry: tuple[PanoramaRenderer, tuple[np.ndarray, np.ndarray] | None]
         if isinstance(self.model, PanoramaCamera) and level:
             entry = (PanoramaRenderer(self.scene, Grid.of_panorama(self.model), eye_z, layers=self.layers), None)
         else:

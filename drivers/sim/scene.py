@@ -88,6 +88,26 @@ class Scene:
             tex_index += [index] * (len(wall.points) - 1)
         for pillar in world.pillars:
             tex_index.append(builder.add(_surface_texture(pillar.texture, 2 * math.pi * pillar.radius, pillar.height)))
+        ground = self._add_ground(builder)
+        sky_idx, sky_w, sky_h = self._add_sky(builder)
+        atlas, origins = builder.build()
+        self._lay_out_surfaces(origins, tex_index)
+        floor_idx, ceiling_idx, floor_w, floor_h, floor_ppm = ground
+        fu, fv = origins[floor_idx]
+        self.floor_region = Region(fu, fv, floor_w, floor_h, floor_ppm)
+        self.ceiling_region = None
+        if ceiling_idx is not None:
+            cu, cv = origins[ceiling_idx]
+            self.ceiling_region = Region(cu, cv, floor_w, floor_h, floor_ppm)
+        su, sv = origins[sky_idx]
+        self.sky_region = Region(su, sv, 3 * sky_w, sky_h, SKY_PX_PER_RAD)
+        self.sky_horizon_v = sv + sky_h // 2  # atlas row of elevation 0 in the sky band
+        self.atlas = atlas
+
+    def _add_ground(self, builder: AtlasBuilder) -> tuple[int, int | None, int, int, float]:
+        """Floor (and ceiling) textures over the world's bounds plus the margin: (floor index, ceiling
+        index or None, width, height, texels per metre)."""
+        world = self.world
         floor_ppm = world.floor.pixels_per_m
         x0, y0, x1, y1 = world.bounds()
         m = world.ground_margin
@@ -105,15 +125,20 @@ class Scene:
         if world.ceiling is not None:
             ceil_spec = TextureSpec(world.seed * 1000 + 999, floor_ppm, 0.5, 200.0, 0.3)
             ceiling_idx = builder.add(make_texture(ceil_spec, floor_w, floor_h))
+        return floor_idx, ceiling_idx, floor_w, floor_h, floor_ppm
+
+    def _add_sky(self, builder: AtlasBuilder) -> tuple[int, int, int]:
+        """The sky band (three periods side by side): (index, width of one period, height)."""
+        world = self.world
         sky_w = int(math.ceil(2 * math.pi * SKY_PX_PER_RAD))
         sky_h = int(math.ceil(2 * SKY_TOP * SKY_PX_PER_RAD)) + 2
         sky = make_sky(world.seed * 1000 + 998, sky_w, sky_h, indoor=world.ceiling is not None)
-        horizon = sky_h // 2
-        sky[horizon:] = int(world.floor.brightness)  # below the horizon: far ground, the floor's mean grey
+        sky[sky_h // 2:] = int(world.floor.brightness)  # below the horizon: far ground, the floor's mean grey
         # three periods side by side: the renderer samples azimuths in [pi, 5 pi], no modulo
-        sky_idx = builder.add(np.hstack([sky, sky, sky]))
-        atlas, origins = builder.build()
+        return builder.add(np.hstack([sky, sky, sky])), sky_w, sky_h
 
+    def _lay_out_surfaces(self, origins: list[tuple[int, int]], tex_index: list[int]) -> None:
+        """Where each wall segment's and pillar's texels sit in the atlas, as per-surface tables."""
         n_segments = self.n_segments
         self.tex_u0 = np.asarray([origins[i][0] for i in tex_index], dtype=float).reshape(-1)
         # atlas row of z = 0 on each surface (texture row 0 is the top of the surface)
@@ -134,16 +159,6 @@ class Scene:
                  self.tex_u0[n_segments:], np.ones(len(self.circle_r))]
             )  # fmt: skip
         self._u_columns = tuple(np.ascontiguousarray(table[:, i]) for i in range(5))
-        fu, fv = origins[floor_idx]
-        self.floor_region = Region(fu, fv, floor_w, floor_h, floor_ppm)
-        self.ceiling_region = None
-        if ceiling_idx is not None:
-            cu, cv = origins[ceiling_idx]
-            self.ceiling_region = Region(cu, cv, floor_w, floor_h, floor_ppm)
-        su, sv = origins[sky_idx]
-        self.sky_region = Region(su, sv, 3 * sky_w, sky_h, SKY_PX_PER_RAD)
-        self.sky_horizon_v = sv + horizon  # atlas row of elevation 0 in the sky band
-        self.atlas = atlas
 
     # ----------------------------------------------------------------------------------------
     # Rays
@@ -211,7 +226,7 @@ class Scene:
                 break
             k = np.where(found, index[j], -1)
             out.append(ColumnHits(d, k, self._texture_u(origin, dirs, np.where(found, d, 0.0), index[j])))
-            if layer + 1 < n_layers:
+            if top is not None and layer + 1 < n_layers:
                 dist = np.where(top > top[cols, j][:, None] + 1e-12, dist, np.inf)
         return out
 

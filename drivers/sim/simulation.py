@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from drivers.interfaces import Robot
+from drivers.interfaces import Camera, Robot
 from drivers.sim.cameras import SimCamera, run_lighting
 from drivers.sim.kinematics import DiffDrive, DiffDriveLimits, SlipModel
 from drivers.sim.ptu import SimPanTilt
@@ -129,7 +129,8 @@ class Simulation:
             )  # fmt: skip
             camera.enabled_noise = noise
             self.cameras[spec.name] = camera
-        self.robot = Robot(base=SimBase(self), ptu=self.ptu, cameras=dict(self.cameras), name=f"sim:{self.name}")
+        cameras: dict[str, Camera] = dict(self.cameras)
+        self.robot = Robot(base=SimBase(self), ptu=self.ptu, cameras=cameras, name=f"sim:{self.name}")
         self.truth = GroundTruth()
         self.truth.record(0.0, self.drive.true(0.0), self.drive.odometry(0.0))
         self._rerun = RerunLogger()

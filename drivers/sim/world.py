@@ -307,7 +307,7 @@ def _surfaces(model: wf.WorldFile) -> dict[str, Any]:
         outline = _box_outline(tuple(box.center), tuple(box.size), math.radians(box.yaw_deg))
         walls.append(Wall(outline, box.height, texture(box), two_sided=False))
     pillars = [Pillar(p.center[0], p.center[1], p.radius, p.height, texture(p)) for p in model.pillars]
-    landmarks = [Landmark(lm.id if lm.id is not None else i, *lm.position, size=lm.size)
+    landmarks = [Landmark(lm.id if lm.id is not None else i, lm.position[0], lm.position[1], lm.position[2], lm.size)
                  for i, lm in enumerate(model.landmarks)]
     return {"walls": tuple(walls), "pillars": tuple(pillars), "landmarks": tuple(landmarks)}
 

@@ -20,7 +20,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, Field, field_validator, model_validator
 
 from maps.located import FILE_MODEL_CONFIG
-from perception.camera import PanoramaCamera, StereoRig, camera_from_dict
+from perception.camera import PanoramaCamera, PinholeCamera, StereoRig, camera_from_dict
 
 FORMAT_VERSION = 1
 MAX_COORD = 10_000.0  # m: the extent of any world
@@ -262,6 +262,8 @@ def camera_model(kind: str, data: dict[str, Any]) -> Any:
         if isinstance(baseline, bool) or not isinstance(baseline, (int, float)) or not 0.0 < baseline <= 10.0:
             raise ValueError(f"baseline must be a number of metres in (0, 10], got {baseline!r}")
         pin = camera_from_dict({"kind": "pinhole", **_PINHOLE_DEFAULTS, **data})
+        if not isinstance(pin, PinholeCamera):
+            raise ValueError("a stereo pair is made of pinhole cameras")
         return StereoRig(pin, pin, float(baseline))
     if kind == "pinhole":
         data = {**_PINHOLE_DEFAULTS, **data}
@@ -299,7 +301,7 @@ class WorldFile(BaseModel):
 
     model_config = FILE_MODEL_CONFIG
 
-    format: Literal[1] = Field(FORMAT_VERSION, description="format version")
+    format: Literal[1] = Field(1, description="format version")
     name: str | None = Field(None, min_length=1, max_length=200, description="default: the file name")
     description: str = Field("", max_length=20_000)
     seed: Seed = Field(0, description="base seed of the generated textures")

@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from collections.abc import Callable
@@ -68,7 +69,7 @@ def _measure(quick: bool) -> dict:
         sim = Simulation.load(world, seed=0)
         poses = _path(sim, 64)
         sim.snapshot(poses[0])  # textures and lookup tables are built once, outside the timing
-        rate = _rate(lambda i, sim=sim, poses=poses: sim.snapshot(poses[i % len(poses)]), n)
+        rate = _rate(functools.partial(_snapshot_on_path, sim, poses), n)
         figures[f"panoramas_per_s_{world}"] = round(rate, 1)
         figures[f"panorama_cost_ratio_{world}"] = round(remap_rate / rate, 3)
     sim = Simulation.load("lab", seed=0, start=Pose2D(4.3, 2.3, 0.0))  # a 1.5 m circle clear of obstacles
@@ -86,6 +87,14 @@ def _measure(quick: bool) -> dict:
     others = {}
     for name in ("omni", "front", "stereo"):
         sim.snapshot(start, name)
-        others[name] = round(1e3 / _rate(lambda i, name=name: sim.snapshot(start, name), max(5, n // 20)), 3)
+        others[name] = round(1e3 / _rate(functools.partial(_snapshot_at, sim, start, name), max(5, n // 20)), 3)
     figures["other_cameras_ms"] = others
     return figures
+
+
+def _snapshot_on_path(sim: Simulation, poses: list[Pose2D], i: int) -> object:
+    return sim.snapshot(poses[i % len(poses)])
+
+
+def _snapshot_at(sim: Simulation, pose: Pose2D, camera: str, _i: int) -> object:
+    return sim.snapshot(pose, camera)

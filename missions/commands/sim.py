@@ -15,6 +15,7 @@ import numpy as np
 
 from maps.store import InputError, write_bytes_atomic
 from missions.commands.common import EXIT_INVALID, EXIT_OK, fail, print_input_error
+from perception.geometry import Pose2D
 
 SNAPSHOT_DESCRIPTION = """Render the image a simulated camera sees with the robot at a given TRUE pose, and
 write it as an image file (PNG, or any format OpenCV writes, chosen by the file extension). A stereo
@@ -71,7 +72,7 @@ def _help(parser: argparse.ArgumentParser) -> int:
 
 
 
-def parse_pose(text: str, named: dict) -> object:
+def parse_pose(text: str, named: dict) -> Pose2D:
     """``x,y,theta`` (theta in rad, or degrees with a ``deg`` suffix) or a named pose."""
     from perception.geometry import Pose2D
 

@@ -9,13 +9,13 @@ from hypothesis import strategies as st
 
 from missions.language import MissionSpec
 from missions.loader import LIBRARY, load_mission
-from tests.fuzzing import load_or_diagnose
+from tests.fuzzing import examples, load_or_diagnose
 
 SHIPPED = sorted(p.read_text(encoding="utf-8") for p in LIBRARY.glob("*.yaml"))
 NAMES = ["Sequence", "Selector", "Parallel", "Drive", "Rotate", "Wait", "Timeout", "Retry", "Repeat",
          "RecoveryNode", "Guard", "CheckBlackboard", "include", "children", "child", "tree", "inputs",
          "distance", "duration", "memory", "name", "key", "value", "${side}", "{/robot/odometry}", "sense"]
-SETTINGS = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(max_examples=examples(300), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
 def load_text(data: bytes) -> None:

@@ -2,25 +2,12 @@
 
 from __future__ import annotations
 
-import textwrap
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
 from drivers.sim.simulation import Simulation
-
-
-@pytest.fixture
-def world_file(tmp_path: Path) -> Callable[[str], Path]:
-    """Write dedented YAML text to a world file and return its path."""
-
-    def write(text: str, name: str = "world.yaml") -> Path:
-        path = tmp_path / name
-        path.write_text(textwrap.dedent(text))
-        return path
-
-    return write
 
 
 @pytest.fixture

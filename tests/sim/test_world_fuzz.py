@@ -9,13 +9,13 @@ from hypothesis import strategies as st
 
 from drivers.sim.simulation import Simulation
 from drivers.sim.world import World, load_world, shipped_worlds
-from tests.fuzzing import load_or_diagnose
+from tests.fuzzing import examples, load_or_diagnose
 
 SHIPPED = sorted(p.read_text(encoding="utf-8") for p in shipped_worlds().values())
 KEYS = ["name", "start", "poses", "walls", "boxes", "pillars", "landmarks", "cameras", "ptu", "lighting", "points",
         "height", "texture", "center", "size", "radius", "position", "id", "kind", "mount", "model", "x", "y",
         "theta_deg", "closed", "seed", "format", "ceiling"]
-SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
 def load_text(data: bytes) -> None:
