@@ -13,8 +13,13 @@
    correspondences, noise, outliers) next to PoseLib's LO-RANSAC relative pose and OpenCV's
    ``findEssentialMat`` + ``recoverPose``. Those two take pinhole image points, so they get the
    correspondences in front of both cameras (``pinhole_correspondences``): Z-infinity gets all.
-3. Planar homing on synthetic pinhole views next to a RANSAC (same iterations, same Sampson
-   inlier test) around PoseLib's upright planar 3-point minimal solver.
+3. Planar homing (3 degrees of freedom) next to two general 5-point relative-pose estimators,
+   PoseLib's ``estimate_relative_pose`` (LO-RANSAC + refinement) and OpenCV's
+   ``findEssentialMat`` + ``recoverPose`` (``RANSAC``, and ``USAC_MAGSAC``), on issue 13's scenes:
+   150 points in the field of view of the simulator's 640 x 480 front camera, 1 px noise, 25%
+   outliers, a random turn and step, the same pixel correspondences and the same 2 px inlier
+   threshold for all (:func:`planar_comparison`). ``planar_vs_X_*_ratio`` = ours / theirs, from
+   the same run: below 1, ours is better (errors) or faster (time).
 
 Times are medians in milliseconds; errors are medians in degrees.
 """
