@@ -23,9 +23,10 @@ freedom of a planar motion less the unknown scale.
 3. Local optimisation (LO-RANSAC) of every new best hypothesis: the linear system on its inliers,
    each row divided by its Sampson denominator (so the algebraic error becomes the Sampson
    distance), re-solved while the MSAC cost drops.
-4. Refinement: ``scipy.optimize.least_squares`` on (theta, phi) minimising the Sampson distances of
-   the inliers (Huber loss), then the inliers are re-selected and the fit repeated until they
-   settle.
+4. Refinement (paper: "refined by Sampson distance"): ``scipy.optimize.least_squares`` on
+   (theta, phi), Tukey's biweight over all points, then plain least squares on the points within
+   its cut-off, re-selected until they settle; the inliers are those under the threshold at the
+   final estimate.
 5. The sign of the translation (which ``E`` cannot see) comes from the paper's majority vote:
    after de-rotation, points move away from the direction of travel.
 
@@ -271,8 +272,9 @@ def _refine(data: _Data, e: np.ndarray, threshold: float, rounds: int = 3) -> np
     2. plain least squares (the maximum-likelihood fit for Gaussian keypoint noise) on the points
        within ``c`` of the result, re-selected and re-fitted until the set settles.
 
-    On synthetic scenes (1 px noise, threshold 2 px) this halves the gap to a fit on the true
-    inliers, compared with a fit on the RANSAC inliers alone (docs/perception.md).
+    On issue 13's scenes (1 px noise, threshold 2 px) the median rotation error goes from 0.142
+    deg (least squares on the RANSAC inliers) to 0.118; a fit on the true inliers gets 0.104
+    (docs/perception.md, "Planar homing").
     """
     gate = 1.5 * threshold
     everything = np.ones(len(data.A), dtype=bool)
