@@ -169,7 +169,10 @@ class _Data:
 
 
 def _prepare(ref: np.ndarray, cur: np.ndarray, focal: float | tuple[float, float]) -> _Data:
-    fx, fy = (focal, focal) if np.isscalar(focal) else focal  # type: ignore[misc]
+    try:
+        fx, fy = (float(f) for f in np.broadcast_to(np.asarray(focal, dtype=np.float64), (2,)))
+    except (TypeError, ValueError):
+        raise ValueError(f"focal must be fx or (fx, fy) in pixels, got {focal!r}") from None
     if not (np.isfinite(fx) and np.isfinite(fy) and fx > 0 and fy > 0):
         raise ValueError(f"focal lengths must be positive pixels, got {focal!r}")
     return _Data(_design(ref, cur), ref[:, 0], ref[:, 1], cur[:, 0], cur[:, 1], (1.0 / fx, 1.0 / fy))
@@ -218,7 +221,8 @@ def _ransac(
     while done < min(needed, max_iterations):
         k = min(batch, max_iterations - done)
         samples = pool[np.argpartition(rng.random((k, len(pool))), 2, axis=1)[:, :3]]  # 3 distinct
-        _, _, vt = np.linalg.svd(data.A[samples])  # batched 3 x 4 systems: null vector = last row
+        # paper's linear solver: [x2 y1, y2 x1, y2, y1] . e = 0 on 3 points, null vector of 3 x 4
+        _, _, vt = np.linalg.svd(data.A[samples])  # batched: the null vector is the last row of V^T
         hypotheses = _project(vt[:, -1, :])
         costs = _msac(data.sampson(hypotheses), threshold)
         k_best = int(np.argmin(costs))
@@ -352,11 +356,13 @@ def estimate_planar_motion(
     points), never as a guess.
     """
     ref, cur = _as_points(ref, cur)
+    if not (np.isfinite(threshold_px) and threshold_px > 0):
+        raise ValueError(f"threshold_px must be a positive number of pixels, got {threshold_px!r}")
+    data = _prepare(ref, cur, focal)
     n = len(ref)
     none = np.zeros(n, dtype=bool)
-    if n < max(3, min_inliers):
+    if n < max(3, min_inliers):  # paper: at least 3 correspondences for the linear solve
         return PlanarResult(0.0, np.zeros(2), none, PlanarStatus.NOT_ENOUGH_POINTS)
-    data = _prepare(ref, cur, focal)
     pixel = float(np.sqrt(data.inv_f[0] * data.inv_f[1]))  # one pixel in normalised units
     # points at camera height satisfy every planar epipolar constraint: they cannot vouch for one
     informative = np.abs(ref[:, 1]) + np.abs(cur[:, 1]) > 10.0 * threshold_px * pixel
@@ -364,8 +370,9 @@ def estimate_planar_motion(
     if len(pool) < max(3, min_inliers):
         return PlanarResult(0.0, np.zeros(2), none, PlanarStatus.NO_CONSENSUS)
     generator = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+    # paper: E from 3 correspondences linearly (RANSAC here: MSAC scoring + LO, steps 1-3)
     e = _ransac(data, pool, threshold_px, rng=generator, confidence=confidence, max_iterations=max_iterations)
-    if refine:
+    if refine:  # paper: "refined by Sampson distance" (step 4)
         e = _refine(data, e, threshold_px)
     mask = np.abs(data.sampson(e)[0]) < threshold_px  # the inliers of the final estimate
     if (mask & informative).sum() < min_inliers:

@@ -184,3 +184,31 @@ def test_at_least_as_accurate_as_poselib_five_point_on_the_same_scenes():
         ours, theirs = np.median(rows[f"planar_{figure}"]), np.median(rows[f"poselib_relpose_{figure}"])
         assert ours <= theirs, (figure, ours, theirs)
     assert np.mean(rows["planar_ok"]) == 1.0
+
+
+@pytest.mark.parametrize("threshold_px", [0.0, -1.0, float("nan"), float("inf")])
+def test_threshold_must_be_a_positive_number_of_pixels(threshold_px):
+    scene = make_planar_scene(13)
+    with pytest.raises(ValueError, match="threshold_px"):
+        estimate_planar_motion(scene.ref, scene.cur, focal=F, threshold_px=threshold_px)
+
+
+def test_sampson_distance_is_in_pixels_of_an_anisotropic_camera():
+    """The Sampson distance on normalised points with the gradient scaled by (1/fx, 1/fy) equals
+    the Sampson distance of the pixel correspondences under the fundamental matrix."""
+    from perception.planar import _angles_from_e, _e_from_angles, _prepare
+
+    fx, fy, cx, cy = 600.0, 450.0, 320.0, 240.0
+    scene = make_planar_scene(14, n=40, noise=2e-3, outlier_fraction=0.2)
+    theta, phi = np.radians(7.0), np.radians(20.0)
+    e = _e_from_angles(np.array([theta]), np.array([phi]))
+    assert np.allclose(np.concatenate(_angles_from_e(-3.0 * e)) % np.pi, [theta, phi])  # sign and scale free
+    ours = _prepare(scene.ref, scene.cur, (fx, fy)).sampson(e)[0]
+    K = np.array([[fx, 0, cx], [0, fy, cy], [0, 0, 1.0]])
+    Fm = np.linalg.inv(K).T @ planar_essential(theta, np.array([np.sin(phi), np.cos(phi)])) @ np.linalg.inv(K)
+    u1 = np.column_stack((scene.ref, np.ones(40))) @ K.T
+    u2 = np.column_stack((scene.cur, np.ones(40))) @ K.T
+    Fu1, Ftu2 = u1 @ Fm.T, u2 @ Fm
+    gradient = np.sqrt(Fu1[:, 0] ** 2 + Fu1[:, 1] ** 2 + Ftu2[:, 0] ** 2 + Ftu2[:, 1] ** 2)
+    expected = np.einsum("ni,ni->n", u2, Fu1) / gradient
+    assert np.allclose(ours, expected, rtol=1e-9, atol=1e-9)
