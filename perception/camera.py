@@ -401,13 +401,7 @@ def camera_from_dict(d: dict[str, Any]) -> PinholeCamera | PanoramaCamera | Cata
         raise ValueError(f"a camera must be a mapping, got {type(d).__name__}")
     kind = d.get("kind")
     if kind == "stereo":
-        missing = {"left", "right", "baseline"} - set(d)
-        if missing:
-            raise ValueError(f"stereo camera is missing {', '.join(sorted(missing))}")
-        left, right = camera_from_dict(d["left"]), camera_from_dict(d["right"])
-        if not (isinstance(left, PinholeCamera) and isinstance(right, PinholeCamera)):
-            raise ValueError("both cameras of a stereo rig must be pinhole")
-        return StereoRig(left=left, right=right, baseline=_number(d["baseline"], "baseline"))
+        return _stereo_from_dict(d)
     if kind not in _MODELS:
         known = ", ".join([*_MODELS, "stereo"])
         raise ValueError(f"unknown camera kind {kind!r} (known: {known})")
@@ -416,22 +410,32 @@ def camera_from_dict(d: dict[str, Any]) -> PinholeCamera | PanoramaCamera | Cata
     extra = set(d) - fields - {"kind", "calibration"}
     if extra:
         raise ValueError(f"unknown key(s) for a {kind} camera: {', '.join(sorted(map(str, extra)))}")
-    kwargs: dict[str, Any] = {}
-    for name, value in d.items():
-        if name in ("kind", "calibration"):
-            continue
-        if name == "dist":
-            if not isinstance(value, (list, tuple)):
-                raise ValueError("dist must be a list of numbers")
-            kwargs[name] = tuple(_number(x, "dist") for x in value)
-        elif name in ("width", "height"):
-            kwargs[name] = _integer(value, name)
-        else:
-            kwargs[name] = _number(value, name)
+    kwargs = {name: _field(name, value) for name, value in d.items() if name not in ("kind", "calibration")}
     try:
         return cls(**kwargs)
     except TypeError as exc:  # a required field is missing
         raise ValueError(f"{kind} camera: {exc}") from None
+
+
+def _stereo_from_dict(d: dict[str, Any]) -> StereoRig:
+    missing = {"left", "right", "baseline"} - set(d)
+    if missing:
+        raise ValueError(f"stereo camera is missing {', '.join(sorted(missing))}")
+    left, right = camera_from_dict(d["left"]), camera_from_dict(d["right"])
+    if not (isinstance(left, PinholeCamera) and isinstance(right, PinholeCamera)):
+        raise ValueError("both cameras of a stereo rig must be pinhole")
+    return StereoRig(left=left, right=right, baseline=_number(d["baseline"], "baseline"))
+
+
+def _field(name: str, value: Any) -> Any:
+    """One camera field from plain data: ``dist`` a tuple of numbers, sizes integers, else a number."""
+    if name == "dist":
+        if not isinstance(value, (list, tuple)):
+            raise ValueError("dist must be a list of numbers")
+        return tuple(_number(x, "dist") for x in value)
+    if name in ("width", "height"):
+        return _integer(value, name)
+    return _number(value, name)
 
 
 def _number(value: Any, name: str) -> float:

@@ -10,6 +10,7 @@ copy are kept, so a corner on the seam is found once, with its whole neighbourho
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -111,27 +112,39 @@ def detect(
         upright = kind == "sift" or is_panorama
     if wrap is None:
         wrap = is_panorama and camera.wraps
-    detector = _detector(kind, n_features, levels, upright)
     width = gray.shape[1]
     pad = min(SEAM_PAD, width // 2) if wrap else 0
-    if pad:
-        gray = cv2.copyMakeBorder(gray, 0, 0, pad, pad, cv2.BORDER_WRAP)
-        if mask is not None:
-            mask = cv2.copyMakeBorder(mask, 0, 0, pad, pad, cv2.BORDER_WRAP)
-    if kind == "orb" and pad:  # keep the budget for the original width despite the pads' duplicates
-        detector = _detector(kind, int(round(n_features * (width + 2 * pad) / width)), levels, upright)
+    # ORB: keep the budget for the original width despite the pads' duplicates
+    budget = int(round(n_features * (width + 2 * pad) / width)) if kind == "orb" and pad else n_features
+    detector = _detector(kind, budget, levels, upright)
     if not (pad or upright):  # plain case: one pass of OpenCV
         keypoints, descriptors = detector.detectAndCompute(gray, mask)
         if descriptors is None or not keypoints:
             return empty_features(kind)
         return Features(cv2.KeyPoint_convert(keypoints).astype(np.float64), descriptors, kind)
-    keypoints = detector.detect(gray, mask)
-    if pad:  # fold back: keep the central copy, whose neighbourhood is complete
-        u = cv2.KeyPoint_convert(keypoints)[:, 0] if keypoints else np.zeros(0)
-        central = np.flatnonzero((u >= pad - 0.5) & (u < pad + width - 0.5))
-        keypoints = [keypoints[i] for i in central]
+    if pad:
+        gray = cv2.copyMakeBorder(gray, 0, 0, pad, pad, cv2.BORDER_WRAP)
+        mask = None if mask is None else cv2.copyMakeBorder(mask, 0, 0, pad, pad, cv2.BORDER_WRAP)
+    keypoints = _central(detector.detect(gray, mask), pad, width)
     if upright:
         keypoints = _upright(keypoints, dedupe=kind != "orb")
+    return _describe(detector, gray, keypoints, kind, pad, n_features)
+
+
+def _central(keypoints: Sequence[cv2.KeyPoint], pad: int, width: int) -> list[cv2.KeyPoint]:
+    """Fold a wrap-padded detection back: keep the central copy, whose neighbourhood is complete."""
+    if not pad:
+        return list(keypoints)
+    u = cv2.KeyPoint_convert(keypoints)[:, 0] if keypoints else np.zeros(0)
+    central = np.flatnonzero((u >= pad - 0.5) & (u < pad + width - 0.5))
+    return [keypoints[i] for i in central]
+
+
+def _describe(
+    detector: Any, gray: np.ndarray, keypoints: list[cv2.KeyPoint], kind: str, pad: int, n_features: int
+) -> Features:
+    """Descriptors of chosen keypoints, positions shifted back by ``pad``; ORB on a padded
+    panorama keeps the strongest ``n_features`` (the budget of the original width)."""
     if not keypoints:
         return empty_features(kind)
     keypoints, descriptors = detector.compute(gray, keypoints)
@@ -139,7 +152,7 @@ def detect(
         return empty_features(kind)
     uv = cv2.KeyPoint_convert(keypoints).astype(np.float64)
     uv[:, 0] -= pad
-    if kind == "orb" and pad and len(uv) > n_features:  # strongest n_features of the original width
+    if kind == "orb" and pad and len(uv) > n_features:
         responses = np.array([k.response for k in keypoints])
         order = np.argsort(-responses, kind="stable")[:n_features]
         uv, descriptors = uv[order], descriptors[order]

@@ -115,21 +115,26 @@ def make_planar_scene(
     depth_range: tuple[float, float] = (3.0, 8.0),
     noise: float = 0.0,
     outlier_fraction: float = 0.0,
+    half_extent: tuple[float, float] = (1.0, 0.75),
 ) -> PlanarScene:
     """``n`` points 3-8 m ahead, seen before and after a turn ``theta_deg`` and a displacement.
 
     ``noise`` is the std of the normalised-coordinate noise (about pixels / focal length).
+    ``half_extent`` bounds the normalised image, ``|x| < hx`` and ``|y| < hy`` in both views: the
+    default is a 90 x 74 degree field of view; ``(320 / 525, 240 / 525)`` is the simulator's
+    640 x 480 ``front`` camera. Outliers are drawn uniformly inside the same bounds.
     """
     rng = np.random.default_rng(seed)
     theta = np.radians(theta_deg)
     c = np.array([displacement[0], 0.0, displacement[1]])
     R = np.array([[np.cos(theta), 0, np.sin(theta)], [0, 1, 0], [-np.sin(theta), 0, np.cos(theta)]])
+    hx, hy = half_extent
     points = []
-    while len(points) < n:  # points visible in both views (inside a 90 deg field of view)
+    while len(points) < n:  # points visible in both views (inside the field of view)
         z = rng.uniform(*depth_range)
-        p = np.array([rng.uniform(-1, 1) * z, rng.uniform(-0.4, 0.4) * z, z])
+        p = np.array([rng.uniform(-hx, hx) * z, rng.uniform(-0.4, 0.4) * z, z])
         q = R @ (p - c)
-        if q[2] > 0.5 and abs(q[0] / q[2]) < 1 and abs(q[1] / q[2]) < 0.75:
+        if q[2] > 0.5 and abs(q[0] / q[2]) < hx and abs(q[1] / q[2]) < hy:
             points.append(p)
     P = np.array(points)
     Q = (P - c) @ R.T
@@ -140,7 +145,7 @@ def make_planar_scene(
         cur = cur + rng.normal(0, noise, cur.shape)
     outlier = np.zeros(n, dtype=bool)
     outlier[rng.choice(n, int(round(outlier_fraction * n)), replace=False)] = True
-    cur[outlier] = rng.uniform(-1, 1, (int(outlier.sum()), 2)) * [1.0, 0.75]
+    cur[outlier] = rng.uniform(-1, 1, (int(outlier.sum()), 2)) * [hx, hy]
     d = np.array(displacement, dtype=float)
     norm = np.linalg.norm(d)
     return PlanarScene(ref, cur, theta, d / norm if norm > 0 else d, outlier)
