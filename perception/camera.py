@@ -16,6 +16,7 @@ data for the camera YAML; reading and writing the file is the caller's job via `
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
@@ -406,7 +407,7 @@ def camera_from_dict(d: dict[str, Any]) -> PinholeCamera | PanoramaCamera | Cata
         known = ", ".join([*_MODELS, "stereo"])
         raise ValueError(f"unknown camera kind {kind!r} (known: {known})")
     cls = _MODELS[kind]
-    fields = {f for f in cls.__dataclass_fields__}
+    fields = {f.name for f in dataclasses.fields(cls)}
     extra = set(d) - fields - {"kind", "calibration"}
     if extra:
         raise ValueError(f"unknown key(s) for a {kind} camera: {', '.join(sorted(map(str, extra)))}")

@@ -69,9 +69,9 @@ def _detector(kind: str, n_features: int, levels: int | None = None, upright: bo
         # an upright 31-pixel patch only needs a 16-pixel margin, not the 31 a rotated one needs:
         # more of a 172-row panorama is usable and a narrower seam strip suffices
         edge = UPRIGHT_ORB_EDGE if upright else 31
-        return cv2.ORB_create(n_features, nlevels=8 if levels is None else levels, edgeThreshold=edge)
+        return cv2.ORB.create(n_features, nlevels=8 if levels is None else levels, edgeThreshold=edge)
     if kind == "sift":
-        return cv2.SIFT_create(nfeatures=n_features)
+        return cv2.SIFT.create(nfeatures=n_features)
     if kind == "brisk":
         if not hasattr(cv2, "BRISK_create"):
             raise ValueError("BRISK is not in this OpenCV build (removed in OpenCV 5); use orb or sift")
@@ -121,7 +121,7 @@ def detect(
         keypoints, descriptors = detector.detectAndCompute(gray, mask)
         if descriptors is None or not keypoints:
             return empty_features(kind)
-        return Features(cv2.KeyPoint_convert(keypoints).astype(np.float64), descriptors, kind)
+        return Features(np.asarray(cv2.KeyPoint.convert(keypoints), dtype=np.float64), descriptors, kind)
     if pad:
         gray = cv2.copyMakeBorder(gray, 0, 0, pad, pad, cv2.BORDER_WRAP)
         mask = None if mask is None else cv2.copyMakeBorder(mask, 0, 0, pad, pad, cv2.BORDER_WRAP)
@@ -135,9 +135,9 @@ def _central(keypoints: Sequence[cv2.KeyPoint], pad: int, width: int) -> list[cv
     """Fold a wrap-padded detection back: keep the central copy, whose neighbourhood is complete."""
     if not pad:
         return list(keypoints)
-    u = cv2.KeyPoint_convert(keypoints)[:, 0] if keypoints else np.zeros(0)
+    u = np.asarray(cv2.KeyPoint.convert(keypoints))[:, 0] if keypoints else np.zeros(0)
     central = np.flatnonzero((u >= pad - 0.5) & (u < pad + width - 0.5))
-    return [keypoints[i] for i in central]
+    return [keypoints[int(i)] for i in central]
 
 
 def _describe(
@@ -150,7 +150,7 @@ def _describe(
     keypoints, descriptors = detector.compute(gray, keypoints)
     if descriptors is None or not keypoints:
         return empty_features(kind)
-    uv = cv2.KeyPoint_convert(keypoints).astype(np.float64)
+    uv = np.asarray(cv2.KeyPoint.convert(keypoints), dtype=np.float64)
     uv[:, 0] -= pad
     if kind == "orb" and pad and len(uv) > n_features:
         responses = np.array([k.response for k in keypoints])

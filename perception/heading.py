@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from perception.geometry import wrap_angles
+from perception.geometry import wrap_angle, wrap_angles
 
 
 def circular_median(angles: np.ndarray, weights: np.ndarray | None = None) -> float:
@@ -73,4 +73,4 @@ def scaled_velocity(confidence: float, v_max: float, *, min_confidence: float = 
 
 def heading_flipped(previous: float, current: float, *, limit: float = np.pi / 2) -> bool:
     """True when the heading turned by more than ``limit`` (90 deg): the viewframe was passed."""
-    return bool(abs(wrap_angles(current - previous)) > limit)
+    return bool(abs(wrap_angle(current - previous)) > limit)

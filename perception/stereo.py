@@ -131,7 +131,7 @@ def dense_depth(
     """
     num = int(np.ceil(num_disparities / 16.0) * 16)
     gray = [cv2.cvtColor(im, cv2.COLOR_BGR2GRAY) if im.ndim == 3 else im for im in (left, right)]
-    matcher = cv2.StereoSGBM_create(
+    matcher = cv2.StereoSGBM.create(
         minDisparity=0,
         numDisparities=num,
         blockSize=block_size,

@@ -129,7 +129,7 @@ def make_planar_scene(
     c = np.array([displacement[0], 0.0, displacement[1]])
     R = np.array([[np.cos(theta), 0, np.sin(theta)], [0, 1, 0], [-np.sin(theta), 0, np.cos(theta)]])
     hx, hy = half_extent
-    points = []
+    points: list[np.ndarray] = []
     while len(points) < n:  # points visible in both views (inside the field of view)
         z = rng.uniform(*depth_range)
         p = np.array([rng.uniform(-hx, hx) * z, rng.uniform(-0.4, 0.4) * z, z])

@@ -59,10 +59,16 @@ def _median_ms(samples: list[float]) -> float:
     return round(float(np.median(samples)) * 1e3, 4)
 
 
-def _timed(fn: Callable[[], Any]) -> tuple[Any, float]:
+def _timed(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> tuple[Any, float]:
+    """``fn(*args, **kwargs)`` and the seconds it took."""
     start = time.perf_counter()
-    value = fn()
+    value = fn(*args, **kwargs)
     return value, time.perf_counter() - start
+
+
+def _match_to(viewframe: Any, features: Any) -> Any:
+    """Match a frame's features (and their bearings) against the viewframe: the pipeline's match stage."""
+    return match_landmarks(features, PANO.pixel_to_bearing(features.keypoints_uv), viewframe)
 
 
 def _poses(count: int) -> list[Pose2D]:
@@ -121,7 +127,7 @@ def pipeline_figures(quick: bool) -> dict[str, Any]:
     view = detect(frames[0], camera=PANO)
     viewframe = Landmarks(view.descriptors, PANO.pixel_to_bearing(view.keypoints_uv), view.kind)
 
-    orb = cv2.ORB_create(500)
+    orb = cv2.ORB.create(500)
     matcher = cv2.BFMatcher(cv2.NORM_HAMMING)
     _, bare_view = orb.detectAndCompute(frames[0], None)
 
@@ -134,16 +140,14 @@ def pipeline_figures(quick: bool) -> dict[str, Any]:
     for _ in range(passes):
         for donut, frame, pose in zip(donuts, frames, poses, strict=True):
             start = time.perf_counter()
-            pano, t_unwarp = _timed(lambda d=donut: unwarp(d, unwarp_maps))
-            features, t_detect = _timed(lambda p=pano: detect(p, camera=PANO))
-            found, t_match = _timed(
-                lambda f=features: match_landmarks(f, PANO.pixel_to_bearing(f.keypoints_uv), viewframe)
-            )
-            motion, t_zinf = _timed(lambda m=found: estimate_motion(m.ref, m.cur))
+            pano, t_unwarp = _timed(unwarp, donut, unwarp_maps)
+            features, t_detect = _timed(detect, pano, camera=PANO)
+            found, t_match = _timed(_match_to, viewframe, features)
+            motion, t_zinf = _timed(estimate_motion, found.ref, found.cur)
             stage["total"].append(time.perf_counter() - start)
             for key, value in (("unwarp", t_unwarp), ("detect", t_detect), ("match", t_match), ("zinf", t_zinf)):
                 stage[key].append(value)
-            stage["bare"].append(_timed(lambda f=frame: bare(f))[1])
+            stage["bare"].append(_timed(bare, frame)[1])
             matches.append(len(found))
             ok.append(motion.rotation_ok)
             if motion.rotation_ok:  # the landmarks turn by the opposite of the robot's turn
@@ -214,7 +218,7 @@ def zinf_figures(quick: bool) -> dict[str, Any]:
             noise_deg=0.1,
             outlier_fraction=0.3,
         )
-        motion, t = _timed(lambda s=scene, k=seed: estimate_motion(s.ref, s.cur, rng=k))
+        motion, t = _timed(estimate_motion, scene.ref, scene.cur, rng=seed)
         add("zinf_ms", t)
         add("zinf_rotation_error_deg", rotation_error_deg(motion.rotation, scene.rotation))
         if motion.ok:
@@ -225,23 +229,17 @@ def zinf_figures(quick: bool) -> dict[str, Any]:
         x1, x2 = o1[:, :2] / o1[:, 2:], o2[:, :2] / o2[:, 2:]
         add("pinhole_correspondences", float(front.sum()))
         if poselib is not None:
-            (pose, _), t = _timed(
-                lambda a=x1, b=x2: poselib.estimate_relative_pose(
-                    a, b, cam, cam, {"max_epipolar_error": threshold, "seed": 0}, {}
-                )
-            )
+            (pose, _), t = _timed(poselib.estimate_relative_pose, x1, x2, cam, cam,
+                                  {"max_epipolar_error": threshold, "seed": 0}, {})
             R, c = _body_motion(pose.R, pose.t)
             add("poselib_ms", t)
             add("poselib_rotation_error_deg", rotation_error_deg(R, scene.rotation))
             add("poselib_translation_error_deg", angle_deg(c, scene.position))
-        E_and_mask, t_e = _timed(
-            lambda a=x1, b=x2: cv2.findEssentialMat(a, b, np.eye(3), method=cv2.RANSAC, prob=0.999, threshold=threshold)
-        )
+        E_and_mask, t_e = _timed(cv2.findEssentialMat, x1, x2, np.eye(3), method=cv2.RANSAC, prob=0.999,
+                                 threshold=threshold)
         E, mask = E_and_mask
         if E is not None and E.shape == (3, 3):
-            (_, R_opt, t_opt, _), t_r = _timed(
-                lambda e=E, a=x1, b=x2, m=mask: cv2.recoverPose(e, a, b, np.eye(3), mask=m)
-            )
+            (_, R_opt, t_opt, _), t_r = _timed(cv2.recoverPose, E, x1, x2, np.eye(3), mask=mask)
             R, c = _body_motion(R_opt, t_opt)
             add("opencv_essential_ms", t_e + t_r)
             add("opencv_rotation_error_deg", rotation_error_deg(R, scene.rotation))
@@ -342,20 +340,17 @@ def planar_comparison(
 
     for seed in seeds:
         s = planar_scene(seed, **scene)
-        result, t = _timed(
-            lambda s=s, k=seed: estimate_planar_motion(
-                s.ref, s.cur, focal=(cam.fx, cam.fy), threshold_px=threshold_px, rng=k
-            )
-        )
+        result, t = _timed(estimate_planar_motion, s.ref, s.cur, focal=(cam.fx, cam.fy), threshold_px=threshold_px,
+                           rng=seed)
         c = np.array([result.direction[0], 0.0, result.direction[1]])
         add("planar", rotation_y(result.theta), c, t, s)
         rows.setdefault("planar_ok", []).append(float(result.ok))
         if poselib is not None:
-            (R, c), t = _timed(lambda s=s: _poselib_relpose(poselib, s, threshold_px))
+            (R, c), t = _timed(_poselib_relpose, poselib, s, threshold_px)
             add("poselib_relpose", R, c, t, s)
         if opencv:
             for name, method in (("opencv_ransac", cv2.RANSAC), ("opencv_magsac", cv2.USAC_MAGSAC)):
-                (R, c), t = _timed(lambda s=s, m=method: _opencv_relpose(s, threshold_px, m))
+                (R, c), t = _timed(_opencv_relpose, s, threshold_px, method)
                 add(name, R, c, t, s)
     return rows
 
