@@ -153,7 +153,8 @@ class FreeGrid:
 
     @property
     def shape(self) -> tuple[int, int]:
-        return self.free.shape  # type: ignore[return-value]
+        rows, cols = self.free.shape
+        return rows, cols
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
