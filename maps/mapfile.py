@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from maps.store import Diagnostic, InputError, checksum, write_bytes_atomic
+from maps.store import Diagnostic, InputError, checksum, read_bytes, write_bytes_atomic
 
 MAGIC = b"BEARINGS-MAP\n"
 MAX_HEADER_BYTES = 1 << 20  # a header is a few hundred bytes; a longer "line" is not a map file
@@ -122,17 +122,5 @@ def decode_map(data: bytes, *, file: str, kind: str | None = None, versions: Ite
 def read_map_file(path: str | os.PathLike, *, kind: str | None = None, versions: Iterable[int] | None = None
                   ) -> MapFile:
     """Load a map file, checking magic, kind, version, length and checksum before decoding."""
-    name = str(path)
-    try:
-        size = os.stat(path).st_size
-        if size > MAX_MAP_BYTES + MAX_HEADER_BYTES:
-            raise InputError([Diagnostic(name, 0, 0, f"too large for a map file ({size} bytes)")])
-        with open(path, "rb") as handle:
-            data = handle.read()
-    except FileNotFoundError:
-        raise InputError([Diagnostic(name, 0, 0, "no such file")]) from None
-    except IsADirectoryError:
-        raise InputError([Diagnostic(name, 0, 0, "is a directory, not a map file")]) from None
-    except OSError as exc:
-        raise InputError([Diagnostic(name, 0, 0, f"cannot read: {exc.strerror}")]) from None
-    return decode_map(data, file=name, kind=kind, versions=versions)
+    data = read_bytes(path, limit=len(MAGIC) + MAX_HEADER_BYTES + MAX_MAP_BYTES, what="a map file")
+    return decode_map(data, file=str(path), kind=kind, versions=versions)

@@ -182,21 +182,29 @@ def parse_yaml(text: str, *, file: str = "<string>") -> Any:
             loader.dispose()
 
 
-def read_text(path: str | os.PathLike) -> str:
-    """Read a UTF-8 text file named by the user; clear :class:`InputError` on any failure."""
+def read_bytes(path: str | os.PathLike, *, limit: int, what: str) -> bytes:
+    """The bytes of a file named by the user, at most ``limit`` of them (``/dev/zero`` or a 300 MB
+    line must not fill memory); a clear :class:`InputError` on any failure. ``what`` names the
+    kind of file in the too-large message."""
     name = str(path)
     try:
-        with open(path, "rb") as handle:  # bounded: /dev/zero or a 300 MB line must not fill memory
-            data = handle.read(MAX_FILE_BYTES + 1)
+        with open(path, "rb") as handle:
+            data = handle.read(limit + 1)
     except FileNotFoundError:
         raise InputError([Diagnostic(name, 0, 0, "no such file")]) from None
     except IsADirectoryError:
         raise InputError([Diagnostic(name, 0, 0, "is a directory, not a file")]) from None
     except OSError as exc:
         raise InputError([Diagnostic(name, 0, 0, f"cannot read: {exc.strerror}")]) from None
-    if len(data) > MAX_FILE_BYTES:
-        raise InputError([Diagnostic(name, 0, 0, f"larger than {MAX_FILE_BYTES // (1024 * 1024)} MB: not a "
-                                     "mission, world or profile file")])
+    if len(data) > limit:
+        raise InputError([Diagnostic(name, 0, 0, f"larger than {limit // (1024 * 1024)} MB: not {what}")])
+    return data
+
+
+def read_text(path: str | os.PathLike) -> str:
+    """Read a UTF-8 text file named by the user; clear :class:`InputError` on any failure."""
+    name = str(path)
+    data = read_bytes(path, limit=MAX_FILE_BYTES, what="a mission, world or profile file")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
