@@ -21,6 +21,12 @@ SIGINT / SIGTERM           INTERRUPTED  130 / 143, even while a behaviour blocks
 
 In every case the base and the pan-tilt unit are commanded to stop before any driver closes,
 and the last command recorded (report and recording) is a zero velocity.
+
+Capabilities add to the report and the recording without touching the runner: any node of the
+tree may define ``report_sections() -> dict`` (merged into the report by section name: the
+``ltmap``, ``roadmap`` and ``exploration`` sections of DESIGN.md) and ``log_rerun(rec)`` (called
+after every recorded tick). Behaviours still never see ground truth: the simulator adds its
+``ground_truth`` section as an observer, and evaluations combine the two.
 """
 
 from __future__ import annotations
@@ -114,6 +120,7 @@ class Runner:
         self.last_command: VelocityCommand = STOP
         self._last_ptu: PanTiltCommand | None = None
         self._recorder: Recorder | None = None
+        self._loggers: list[Any] = []
         self._wall_start = time.monotonic()
         py_trees.blackboard.Blackboard.clear()  # one run, one blackboard: nothing leaks between runs
         root, self.task = build_root(mission)
@@ -165,6 +172,7 @@ class Runner:
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
         self.tree.setup(clock=self.clock, robot=self.robot)  # hand every node the clock and the drivers
+        self._loggers = [node for node in self.root.iterate() if callable(getattr(node, "log_rerun", None))]
 
     def _loop(self) -> tuple[str, str]:
         last_progress = 0.0
@@ -242,7 +250,7 @@ class Runner:
         if self._recorder is not None:
             self._recorder.log_tick(time_s=self.clock.now(), tick=self.ticks + 1, root=self.root,
                                     odometry=self._get("/robot/odometry"), command=self.last_command,
-                                    observers=self.observers)
+                                    observers=(*self.observers, *self._loggers))
 
     # -- helpers ---------------------------------------------------------------------------------
     def _get(self, key: str) -> Any:
@@ -250,6 +258,20 @@ class Runner:
             return py_trees.blackboard.Blackboard.get(key)
         except KeyError:
             return None
+
+    def _node_sections(self) -> dict[str, dict[str, Any]]:
+        """What the tree's nodes add to the report (a node that fails to say is noted, not fatal)."""
+        sections: dict[str, dict[str, Any]] = {}
+        for node in self.root.iterate():
+            method = getattr(node, "report_sections", None)
+            if not callable(method):
+                continue
+            try:
+                for section, values in method().items():
+                    sections.setdefault(section, {}).update(values)
+            except Exception as exc:  # noqa: BLE001 - the report must be written whatever a node does
+                sections.setdefault("report_errors", {})[node.name] = describe_exception(exc)
+        return sections
 
     def _outcome_reason(self) -> str:
         if self.root.status == Status.SUCCESS:
@@ -287,6 +309,8 @@ class Runner:
             report["sim_time_s"] = round(result.time_s, 6)
         for observer in self.observers:
             report.update(observer.report_sections(mission.evaluation))
+        for section, values in self._node_sections().items():
+            report.setdefault(section, {}).update(values)
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}

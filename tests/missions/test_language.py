@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import textwrap
 
@@ -11,6 +12,7 @@ import pytest
 from behaviours import registry
 from behaviours.ports import Ref
 from maps.store import InputError, load_yaml
+from missions.cli import main
 from missions.loader import LIBRARY, load_mission
 from missions.schema import mission_schema
 
@@ -206,3 +208,24 @@ def _plain(value):
     if isinstance(value, list):
         return [_plain(v) for v in value]
     return value
+
+
+def test_world_and_profile_schemas_come_from_the_declared_models(capsys):
+    from drivers.sim.world import shipped_worlds
+    from missions.profiles import PROFILES
+
+    assert main(["schema", "--world"]) == 0
+    world_schema = json.loads(capsys.readouterr().out)
+    jsonschema.Draft202012Validator.check_schema(world_schema)
+    validator = jsonschema.Draft202012Validator(world_schema)
+    for path in shipped_worlds().values():
+        assert not list(validator.iter_errors(_plain(load_yaml(path)))), path
+    assert list(validator.iter_errors({"walls": [{"points": [[0, 0], [1, 0]], "height": 500}]}))
+    assert world_schema["properties"]["ceiling"]["anyOf"][0]["unit"] == "m"
+    assert main(["schema", "--profile"]) == 0
+    profile_schema = json.loads(capsys.readouterr().out)
+    jsonschema.Draft202012Validator.check_schema(profile_schema)
+    validator = jsonschema.Draft202012Validator(profile_schema)
+    for path in PROFILES.glob("*.yaml"):
+        assert not list(validator.iter_errors(_plain(load_yaml(path)))), path
+    assert list(validator.iter_errors({"base": {"driver": "pioneer"}, "wheels": 4}))

@@ -219,3 +219,33 @@ def test_runner_refuses_a_missing_camera_at_setup_before_any_motion(write_missio
     assert result.status == "FAILURE" and result.ticks == 0
     assert "has no camera periscope (it has: front)" in result.reason
     assert robot.base.commands == [(0.0, 0.0)]
+
+
+REPORTING_PLUGIN = """
+from py_trees.common import Status
+from behaviours.base import BearingsBehaviour
+from behaviours.registry import register
+
+@register
+class CountTicks(BearingsBehaviour):
+    '''Counts its ticks; reports them and logs them to rerun (a test plugin).'''
+    def initialise(self):
+        self.ticks, self.logged = 0, 0
+    def update(self):
+        self.ticks += 1
+        return Status.SUCCESS if self.ticks == 5 else Status.RUNNING
+    def report_sections(self):
+        return {"counting": {"ticks": self.ticks, "logged": self.logged}}
+    def log_rerun(self, rec):
+        self.logged += 1
+        rec.log("counting/ticks", rec.Scalars([self.ticks]))
+"""
+
+
+def test_nodes_add_report_sections_and_recordings(write_mission, tmp_path):
+    (tmp_path / "count.py").write_text(REPORTING_PLUGIN)
+    mission = _mission(write_mission, "CountTicks\n", plugins="[count.py]", cameras="[]")
+    result = Runner(mission, fake_robot(), clock=ManualClock(),
+                    options=RunOptions(save_path=tmp_path / "run.rrd")).run()
+    assert result.status == "SUCCESS"
+    assert result.report["counting"] == {"ticks": 5, "logged": 5}
