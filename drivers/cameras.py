@@ -29,7 +29,7 @@ import urllib.request
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import cv2
 import numpy as np
@@ -54,8 +54,8 @@ class CameraError(OSError):
 class _CameraSettings(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
-    name: str | None = Field(None, description="camera name stamped on its frames (default: 'camera'; "
-                             "the profile loader passes the entry's key)")
+    name: str | None = Field(None, min_length=1, max_length=64, description="camera name stamped on its "
+                             "frames (default: 'camera'; the profile loader passes the entry's key)")
     calibration: str | None = Field(None, description="camera model YAML (from 'bearings calibrate', or a "
                                     "catadioptric/panorama model); its size must match the frames")
     unwarp: bool = Field(False, description="deliver a catadioptric camera's frames unwarped to a 720 x 172 "
@@ -69,8 +69,9 @@ class _CameraSettings(BaseModel):
 class OpenCVCameraSettings(_CameraSettings):
     """A camera read with ``cv2.VideoCapture`` (``cameras: {front: {driver: opencv, device: 0}}``)."""
 
-    device: int | str = Field(description="device index (0 = /dev/video0), a video file, or a stream URL "
-                              "(rtsp://..., http://.../video.mjpg)")
+    device: Annotated[int, Field(ge=0, le=255)] | Annotated[str, Field(min_length=1)] = Field(
+        description="device index (0 = /dev/video0), a video file, or a stream URL (rtsp://..., "
+        "http://.../video.mjpg)")
     width: int | None = quantity(None, "frame width to ask the device for", "px", ge=16, le=8192)
     height: int | None = quantity(None, "frame height to ask the device for", "px", ge=16, le=8192)
     fps: float | None = quantity(None, "frame rate to ask the device for; for a file, the playback rate "

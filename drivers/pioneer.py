@@ -80,7 +80,7 @@ class PioneerSettings(BaseModel):
                                   "100 ms)", "s", ge=0.05, le=5.0)
     resend_period: float = quantity(0.2, "period of re-sending the current velocity command (a command "
                                     "at least every 0.5 s keeps the robot's watchdog quiet)", "s",
-                                    ge=0.01, le=0.5)
+                                    ge=0.01, le=0.45)
     command_timeout: float = quantity(1.0, "no drive() call for this long while moving stops the base "
                                       "(guards against a stuck control loop)", "s", ge=0.05, le=60.0)
     max_speed: float | None = quantity(None, "forward speed limit (default: the model's)", "m/s",

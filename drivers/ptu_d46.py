@@ -353,30 +353,33 @@ class PtuD46:
         self._skip_pending()
         self._serial.write(data)
         deadline = time.monotonic() + self.settings.reply_timeout
-        while time.monotonic() < deadline:
+        answer: codec.Reply | None = None
+        while answer is None and time.monotonic() < deadline:
             chunk = self._serial.read(self._serial.in_waiting or 1)
             for line in self._lines.feed(chunk) if chunk else ():
                 reply = codec.parse_line(line)
-                if reply.kind == "error" or (reply.kind == "ok" and _fits(reply, shape)):
-                    return reply
-                if reply.kind == "ok":
-                    self.late_replies += 1
-                elif reply.kind == "limit":
-                    self.limit_hits += 1
-                    log.info("PTU-D46 reports a %s limit hit", reply.axis)
-        raise _Timeout(data.decode("ascii").strip())
+                if answer is None and (reply.kind == "error" or (reply.kind == "ok" and _fits(reply, shape))):
+                    answer = reply
+                else:
+                    self._note_unsolicited(reply)
+        if answer is None:
+            raise _Timeout(data.decode("ascii").strip())
+        return answer
+
+    def _note_unsolicited(self, reply: codec.Reply) -> None:
+        """A line that answers nothing we wait for: count limit hits and late replies, ignore noise."""
+        if reply.kind == "limit":
+            self.limit_hits += 1
+            log.info("PTU-D46 reports a %s limit hit", reply.axis)
+        elif reply.kind in ("ok", "error"):
+            self.late_replies += 1
 
     def _skip_pending(self) -> None:
         """Before a command: read what is waiting (unsolicited lines, late replies) so it cannot be
         taken for this command's reply; a half-received line is dropped."""
         while self._serial.in_waiting:
             for line in self._lines.feed(self._serial.read(self._serial.in_waiting)):
-                reply = codec.parse_line(line)
-                if reply.kind == "limit":
-                    self.limit_hits += 1
-                    log.info("PTU-D46 reports a %s limit hit", reply.axis)
-                elif reply.kind in ("ok", "error"):
-                    self.late_replies += 1
+                self._note_unsolicited(codec.parse_line(line))
         self._lines.clear()
 
     # -- helpers -----------------------------------------------------------------------------------

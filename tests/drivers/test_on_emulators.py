@@ -129,6 +129,17 @@ def test_shipped_profiles_are_valid_for_the_drivers():
             models[entry["driver"]].model_validate(fields)
 
 
+def test_every_setting_is_documented():
+    from drivers.cameras import HttpCameraSettings, OpenCVCameraSettings
+    from drivers.pioneer import PioneerSettings
+    from drivers.ptu_d46 import PtuD46Settings
+
+    page = (Path(__file__).resolve().parents[2] / "docs" / "hardware.md").read_text()
+    for model in (PioneerSettings, PtuD46Settings, OpenCVCameraSettings, HttpCameraSettings):
+        for name in model.model_fields:
+            assert f"`{name}`" in page, f"{model.__name__}.{name} is not in docs/hardware.md"
+
+
 def arcos_identity(name: str, subclass: str) -> arcos.Identity:
     return arcos.Identity(name, "Pioneer", subclass)
 

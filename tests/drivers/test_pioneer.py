@@ -89,7 +89,7 @@ def test_commands_are_resent_well_inside_the_watchdog(base):
     assert not emulator.named("watchdog") and emulator.v == 100.0
     times = [e.t for e in emulator.named("VEL")]
     gaps = [b - a for a, b in zip(times, times[1:], strict=False)]
-    assert max(gaps) < FAST_BASE["resend_period"] + 0.05
+    assert max(gaps) < 4 * FAST_BASE["resend_period"]  # well inside the 0.5 s the robot needs
 
 
 def test_the_emulator_watchdog_stops_a_silent_client(arcos):
@@ -106,7 +106,7 @@ def test_the_emulator_watchdog_stops_a_silent_client(arcos):
         assert emulator.wait_for(lambda: emulator.v == 300.0)
         quiet = time.monotonic()
         assert emulator.wait_for(lambda: emulator.named("watchdog"), timeout=1.0)
-        assert emulator.named("watchdog")[0].t - quiet == pytest.approx(0.25, abs=0.05)
+        assert emulator.named("watchdog")[0].t - quiet == pytest.approx(0.25, abs=0.08)
         assert not emulator.moving
     finally:
         port.close()
@@ -204,12 +204,14 @@ def test_odometry_crosses_the_position_wrap(base):
 def test_calls_never_block(base):
     pioneer, emulator = base(settings={"sip_timeout": 1.0})
     emulator.mute = True  # no SIPs: the driver has nothing new, but must not wait for it
+    durations = []
     for _ in range(50):
         start = time.perf_counter()
         pioneer.drive(0.1, 0.1)
         pioneer.odometry()
         pioneer.stalled()
-        assert time.perf_counter() - start < 0.005
+        durations.append(time.perf_counter() - start)
+    assert sorted(durations)[25] < 0.001 and max(durations) < 0.05  # no wait for I/O, even at worst
 
 
 # -- faults --------------------------------------------------------------------------------------------
@@ -239,6 +241,7 @@ def test_no_sip_is_a_fault_and_the_stop_arrives_in_time(base):
     muted = time.monotonic()
     assert emulator.wait_for(lambda: pioneer.fault is not None, timeout=1.0)
     assert "no SIP" in pioneer.fault
+    assert emulator.wait_for(lambda: _zero_velocity_after(emulator, muted) is not None)
     stop = _zero_velocity_after(emulator, muted)
     assert stop is not None and stop.t - muted <= FAST_BASE["sip_timeout"] + STOP_WITHIN
     assert any(e.arg == 0 for e in emulator.named("ENABLE") if e.t >= muted)  # motors disabled
