@@ -368,6 +368,8 @@ class PioneerBase:
                 return self._pending.pop(0)
             if time.monotonic() >= until:
                 return None
+            if self._closing.is_set() or self._serial is None:
+                raise ConnectionError("the base is being closed")
             data = self._serial.read(self._serial.in_waiting or 1)
             if data:
                 self._pending = self._reader.feed(data)

@@ -187,7 +187,7 @@ arguments = st.one_of(st.none(), st.integers(-0xFFFF, 0xFFFF), st.binary(max_siz
 
 
 @given(command=st.integers(0, 255), arg=arguments)
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=100, deadline=None)
 def test_command_round_trip(command, arg):
     packet = arcos.encode_command(command, arg)
     assert len(packet) < 200
@@ -202,7 +202,7 @@ sips = st.builds(Sip, moving=st.booleans(), x=u16, y=u16, theta=i16, left_vel=i1
 
 
 @given(sip=sips)
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=100, deadline=None)
 def test_sip_round_trip(sip):
     payload = arcos.encode_sip(sip)
     assert arcos.decode_sip(arcos.unframe(arcos.frame(payload))) == sip
@@ -211,7 +211,7 @@ def test_sip_round_trip(sip):
 @given(payloads=st.lists(st.binary(min_size=1, max_size=60), max_size=8),
        noise=st.lists(st.binary(max_size=12).map(lambda b: b.replace(b"\xfa", b"")), max_size=9),
        cuts=st.lists(st.integers(1, 40), max_size=30))
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=100, deadline=None)
 def test_reader_finds_every_packet_whatever_the_noise_and_the_chunking(payloads, noise, cuts):
     stream = b""
     for i, payload in enumerate(payloads):
@@ -225,7 +225,7 @@ def test_reader_finds_every_packet_whatever_the_noise_and_the_chunking(payloads,
 
 
 @given(data=st.binary(max_size=300))
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=150, deadline=None)
 def test_reader_never_raises_on_noise(data):
     for payload in PacketReader().feed(data):
         assert arcos.MIN_COUNT - 2 <= len(payload) <= arcos.MAX_COUNT - 2
