@@ -1,0 +1,401 @@
+"""An ARCOS robot for the tests: speaks the protocol over a pty (like a USB-serial Pioneer) or TCP
+(like MobileSim on port 8101), so the real :mod:`drivers.pioneer` code is what gets exercised.
+
+It runs the connection state machine (SYNC0-2 echoes with the identity strings, OPEN, CLOSE), checks
+every checksum of what it receives (``bad_packets`` counts failures), sends a SIP every
+``sip_period``, integrates the commanded VEL/RVEL (``time_scale`` speeds the world up so that a
+mission finishes quickly), and honours the ARCOS watchdog (no command for ``watchdog`` seconds
+stops the robot). Every accepted command is recorded with its time in ``events``.
+
+Faults to inject: ``garbage()`` bytes, ``corrupt(n)`` checksums of the next SIPs, ``tear`` packets
+into pieces, ``mute`` the SIPs (the link still hears commands), ``drop_link()``, ``reply_delay``
+on connection replies, ``sync_glitch`` (a wrong echo), ``start_open`` (a robot still open from an
+earlier client), stalls, bumpers, battery, sonar, e-stop.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import random
+import select
+import socket
+import threading
+import time
+import tty
+from dataclasses import dataclass
+
+from drivers import arcos
+from drivers.arcos import Command, Identity
+
+
+@dataclass(frozen=True)
+class Event:
+    t: float
+    name: str
+    arg: int | bytes | None = None
+
+
+class ArcosEmulator:
+    def __init__(self, *, transport: str = "pty", model: str = "p3dx", identity: Identity | None = None,
+                 sip_period: float = 0.1, watchdog: float = 2.0, time_scale: float = 1.0,
+                 start_pose: tuple[float, float, float] = (0.0, 0.0, 0.0), reply_delay: float = 0.0,
+                 send_config: bool = True, start_open: bool = False, new_firmware: bool = True,
+                 sync_glitch: int = 0, seed: int = 0) -> None:
+        self.transport = transport
+        self.params = arcos.MODELS[model]
+        self.identity = identity or Identity("emulator", "Pioneer", model)
+        self.sip_period = sip_period
+        self.watchdog = watchdog
+        self.time_scale = time_scale
+        self.reply_delay = reply_delay
+        self.send_config = send_config
+        self.new_firmware = new_firmware
+        self.rng = random.Random(seed)
+        # the world
+        self.x, self.y = start_pose[0] * 1000.0, start_pose[1] * 1000.0  # mm
+        self.theta = start_pose[2]  # rad
+        self.start_pose = (self.x, self.y, self.theta)
+        self.v = 0.0  # mm/s commanded
+        self.w = 0.0  # deg/s commanded
+        self.enabled = False
+        self.estop = False
+        self.stall_left = self.stall_right = False
+        self.front_bumpers = self.rear_bumpers = 0
+        self.battery = 12.6  # V
+        self.sonar_ranges: dict[int, int] = {i: 5000 for i in range(8)}  # mm
+        self._sonar_dirty = set(self.sonar_ranges)
+        # the protocol
+        self.state = "open" if start_open else "sync0"
+        self.events: list[Event] = []
+        self.bad_packets = 0
+        self.sips_sent = 0
+        self.tx_dropped = 0
+        self.link_dropped_at: float | None = None
+        self.crashed: BaseException | None = None
+        self.last_rx = time.monotonic()
+        # faults
+        self.tear = False
+        self.mute = False
+        self.sync_glitch = sync_glitch
+        self.accept_connections = True
+        self._corrupt = 0
+        self._outbox: list[tuple[float, bytes]] = []
+        self._reader = arcos.PacketReader()
+        self._lock = threading.RLock()
+        self._running = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._next_sip = time.monotonic()
+        self._last_step = time.monotonic()
+        # the link
+        self._master = self._slave = -1
+        self._listener: socket.socket | None = None
+        self._conn: socket.socket | None = None
+        self.port = self._open_link()
+
+    # -- set-up ------------------------------------------------------------------------------------
+    def _open_link(self) -> str:
+        if self.transport == "pty":
+            self._master, self._slave = os.openpty()
+            tty.setraw(self._slave)  # no echo, no line editing before the driver opens it
+            os.set_blocking(self._master, False)
+            return os.ttyname(self._slave)
+        listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(2)
+        listener.setblocking(False)
+        self._listener = listener
+        return f"socket://127.0.0.1:{listener.getsockname()[1]}"
+
+    def start(self) -> ArcosEmulator:
+        self._running.set()
+        self._thread = threading.Thread(target=self._loop, name="arcos-emulator", daemon=True)
+        self._thread.start()
+        return self
+
+    def close(self) -> None:
+        self._running.clear()
+        if self._thread is not None:
+            self._thread.join(timeout=2.0)
+        self._close_link()
+        if self._listener is not None:
+            with contextlib.suppress(OSError):
+                self._listener.close()
+            self._listener = None
+
+    def __enter__(self) -> ArcosEmulator:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- faults ------------------------------------------------------------------------------------
+    def garbage(self, n: int = 64) -> None:
+        """Send ``n`` bytes of noise, with bogus headers in it, between packets."""
+        noise = bytearray(self.rng.randrange(256) for _ in range(n))
+        noise[n // 3 : n // 3 + 3] = b"\xfa\xfb\xff"  # a header with an impossible count
+        noise[2 * n // 3 : 2 * n // 3 + 4] = b"\xfa\xfb\x05\x32"  # a torn bogus packet
+        self._write(bytes(noise))
+
+    def corrupt(self, n: int = 1) -> None:
+        """Corrupt one payload byte of each of the next ``n`` SIPs after the checksum is computed."""
+        with self._lock:
+            self._corrupt += n
+
+    def drop_link(self) -> None:
+        """Cut the link: the pty or the TCP connection is closed under the driver."""
+        with self._lock:
+            self.link_dropped_at = time.monotonic()
+            self._close_link(keep_listener=True)
+
+    # -- queries for the tests -----------------------------------------------------------------------
+    def pose(self) -> tuple[float, float, float]:
+        """True pose (m, m, rad) relative to the start pose, in the start pose's frame."""
+        with self._lock:
+            x0, y0, t0 = self.start_pose
+            dx, dy = self.x - x0, self.y - y0
+            c, s = math.cos(-t0), math.sin(-t0)
+            return (c * dx - s * dy) / 1000.0, (s * dx + c * dy) / 1000.0, _wrap(self.theta - t0)
+
+    def named(self, name: str) -> list[Event]:
+        with self._lock:
+            return [e for e in self.events if e.name == name]
+
+    def first_after(self, name: str, t: float) -> Event | None:
+        return next((e for e in self.named(name) if e.t >= t), None)
+
+    def wait_for(self, predicate, timeout: float = 2.0) -> bool:
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if predicate():
+                return True
+            time.sleep(0.005)
+        return bool(predicate())
+
+    @property
+    def moving(self) -> bool:
+        return self.v != 0.0 or self.w != 0.0
+
+    # -- the loop ----------------------------------------------------------------------------------
+    def _loop(self) -> None:
+        try:
+            self._serve()
+        except BaseException as exc:  # a bug in the emulator must fail the test, not hang it
+            self.crashed = exc
+            raise
+
+    def _serve(self) -> None:
+        while self._running.is_set():
+            self._accept()
+            data = self._read(0.003)
+            now = time.monotonic()
+            with self._lock:
+                for payload in self._reader.feed(data) if data else ():
+                    self._handle(payload, now)
+                self.bad_packets = self._reader.stats.bad_checksums + self._reader.stats.bad_lengths
+                self._step(now)
+                if self.moving and now - self.last_rx > self.watchdog:  # whatever the link's state
+                    self.v = self.w = 0.0
+                    self.events.append(Event(now, "watchdog"))
+                self._flush_outbox(now)
+                if self.state == "open" and now >= self._next_sip:
+                    self._next_sip = max(self._next_sip + self.sip_period, now)
+                    if not self.mute and self._connected():
+                        self._send_sip()
+
+    def _step(self, now: float) -> None:
+        dt = (now - self._last_step) * self.time_scale
+        self._last_step = now
+        if not (self.enabled and not self.estop) or (self.stall_left or self.stall_right):
+            return
+        w = math.radians(self.w)
+        if abs(w) < 1e-12:
+            self.x += self.v * dt * math.cos(self.theta)
+            self.y += self.v * dt * math.sin(self.theta)
+        else:  # exact arc for constant v, w
+            r = self.v / w
+            self.x += r * (math.sin(self.theta + w * dt) - math.sin(self.theta))
+            self.y -= r * (math.cos(self.theta + w * dt) - math.cos(self.theta))
+        self.theta = _wrap(self.theta + w * dt)
+
+    def _handle(self, payload: bytes, now: float) -> None:
+        try:
+            command, arg = arcos.decode_command(payload)
+        except arcos.PacketError:
+            self.bad_packets += 1
+            return
+        self.last_rx = now
+        name = Command(command).name if command in Command._value2member_map_ else str(command)
+        if self.state in ("sync0", "sync1", "sync2"):
+            self._handle_sync(command, now)
+            return
+        if self.state == "synced":
+            if command == Command.OPEN:
+                self.state = "open"
+                self._next_sip = now
+                self.events.append(Event(now, "OPEN"))
+            return
+        self.events.append(Event(now, name, arg))
+        self._handle_open(command, arg, now)
+
+    def _handle_sync(self, command: int, now: float) -> None:
+        expected = int(self.state[-1])
+        if command != expected:
+            self.state = "sync0"
+            return
+        if command == arcos.SYNC1 and self.sync_glitch > 0:
+            self.sync_glitch -= 1
+            self._reply(arcos.encode_sync(arcos.SYNC0), now)  # out of sequence: the driver restarts
+            self.state = "sync0"
+            return
+        self._reply(arcos.encode_sync(command, self.identity), now)
+        self.state = f"sync{command + 1}" if command < arcos.SYNC2 else "synced"
+
+    def _handle_open(self, command: int, arg: int | bytes | None, now: float) -> None:
+        value = arg if isinstance(arg, int) else 0
+        if command == Command.CLOSE:
+            self.v = self.w = 0.0
+            self.enabled = False
+            self.state = "sync0"
+        elif command == Command.ENABLE:
+            self.enabled = bool(value) and not self.estop
+            if not value:
+                self.v = self.w = 0.0
+        elif command == Command.VEL:
+            self.v = float(max(-self.params.max_vel, min(self.params.max_vel, value))) if self.enabled else 0.0
+        elif command == Command.RVEL:
+            self.w = float(max(-self.params.max_rot_vel, min(self.params.max_rot_vel, value))) if self.enabled else 0.0
+        elif command in (Command.STOP, Command.E_STOP):
+            self.v = self.w = 0.0
+        elif command == Command.CONFIG and self.send_config:
+            self._reply(arcos.encode_config(self._config_values()), now)
+
+    def _config_values(self) -> dict[str, int | str]:
+        return {"robot_type": self.identity.robot_class, "subtype": self.identity.subclass, "serial": "EMU0001",
+                "four_mots": 0, "rot_vel_top": int(self.params.max_rot_vel), "trans_vel_top": int(self.params.max_vel),
+                "rot_accel_top": 300, "trans_accel_top": 2000, "pwm_max": 1000, "name": self.identity.name,
+                "sip_cycle": int(self.sip_period * 1000), "watchdog": int(self.watchdog * 1000),
+                "low_battery": 110, "trans_vel_max": int(self.params.max_vel), "rot_vel_max": 300}
+
+    # -- output ------------------------------------------------------------------------------------
+    def _send_sip(self) -> None:
+        l_vel, r_vel = self._wheel_speeds()
+        sonar = []
+        for index in sorted(self._sonar_dirty)[:8]:
+            sonar.append((index, self.sonar_ranges[index]))
+            self._sonar_dirty.discard(index)
+        low = int(self.stall_left) | (self.rear_bumpers << 1)
+        high = int(self.stall_right) | (self.front_bumpers << 1)
+        stall = low | (high << 8)
+        flags = (1 if self.enabled else 0) | (0x20 if self.estop else 0)
+        volts = int(round(self.battery * 10))
+        extra = volts.to_bytes(2, "little") + b"\x00" + int(round(self.w * 10)).to_bytes(2, "little", signed=True) \
+            if self.new_firmware else b""
+        sip = arcos.Sip(False, int(round(self.x / self.params.dist_conv)) & 0x7FFF,
+                        int(round(self.y / self.params.dist_conv)) & 0x7FFF,
+                        int(round(self.theta / self.params.angle_conv)) % 4096, int(round(l_vel)), int(round(r_vel)),
+                        min(volts, 255), stall, 0, flags, 0, tuple(sonar), extra=extra)
+        packet = bytearray(arcos.frame(arcos.encode_sip(sip)))
+        if self._corrupt > 0:
+            self._corrupt -= 1
+            packet[5] ^= 0x5A  # a payload byte; the checksum no longer matches
+        self.sips_sent += 1
+        self._write(bytes(packet))
+
+    def _wheel_speeds(self) -> tuple[float, float]:
+        if not self.enabled or self.stall_left or self.stall_right:
+            return 0.0, 0.0
+        half = math.radians(self.w) / self.params.diff_conv
+        return (self.v - half) * self.time_scale, (self.v + half) * self.time_scale
+
+    def _reply(self, payload: bytes, now: float) -> None:
+        self._outbox.append((now + self.reply_delay, arcos.frame(payload)))
+
+    def _flush_outbox(self, now: float) -> None:
+        due = [p for t, p in self._outbox if t <= now]
+        self._outbox = [(t, p) for t, p in self._outbox if t > now]
+        for packet in due:
+            self._write(packet)
+
+    def _write(self, data: bytes) -> None:
+        if not self.tear or len(data) < 2:
+            self._raw_write(data)
+            return
+        cut = self.rng.randrange(1, len(data))
+        self._raw_write(data[:cut])
+        time.sleep(0.002)  # the driver may read the first piece alone
+        self._raw_write(data[cut:])
+
+    def _raw_write(self, data: bytes) -> None:
+        try:
+            if self.transport == "pty":
+                if self._master < 0:
+                    raise OSError("link down")
+                os.write(self._master, data)
+            else:
+                if self._conn is None:
+                    raise OSError("no client")
+                self._conn.sendall(data)
+        except OSError:
+            self.tx_dropped += len(data)
+
+    # -- the link ----------------------------------------------------------------------------------
+    def _connected(self) -> bool:
+        return self._master >= 0 if self.transport == "pty" else self._conn is not None
+
+    def _accept(self) -> None:
+        if self._listener is None or not self.accept_connections:
+            return
+        try:
+            conn, _ = self._listener.accept()
+        except (BlockingIOError, OSError):
+            return
+        conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        conn.setblocking(False)
+        with self._lock:
+            if self._conn is not None:
+                with contextlib.suppress(OSError):
+                    self._conn.close()
+            self._conn = conn
+            self._reader.clear()
+            self.state = "sync0"
+
+    def _read(self, timeout: float) -> bytes:
+        fd = self._master if self.transport == "pty" else self._conn
+        if fd is None or fd == -1:
+            time.sleep(timeout)
+            return b""
+        try:
+            ready, _, _ = select.select([fd], [], [], timeout)
+            if not ready:
+                return b""
+            data = os.read(fd, 4096) if self.transport == "pty" else fd.recv(4096)
+        except (BlockingIOError, InterruptedError):
+            return b""
+        except (OSError, ValueError):
+            data = b""
+        if not data and self.transport == "tcp":  # the client went away
+            with self._lock:
+                self._close_link(keep_listener=True)
+                self.state = "sync0"
+        return data
+
+    def _close_link(self, keep_listener: bool = False) -> None:
+        for name in ("_master", "_slave"):
+            fd = getattr(self, name)
+            if fd >= 0:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+                setattr(self, name, -1)
+        if self._conn is not None:
+            with contextlib.suppress(OSError):
+                self._conn.shutdown(socket.SHUT_RDWR)
+            with contextlib.suppress(OSError):
+                self._conn.close()
+            self._conn = None
+
+
+def _wrap(angle: float) -> float:
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
