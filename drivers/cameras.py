@@ -29,7 +29,7 @@ import urllib.request
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, Self
 
 import cv2
 import numpy as np
@@ -160,7 +160,7 @@ class _ThreadedCamera:
         return self._output
 
     # -- the grab thread ---------------------------------------------------------------------------
-    def start(self) -> _ThreadedCamera:
+    def start(self) -> Self:
         self._thread = threading.Thread(target=self._run, name=f"{self.kind} {self.name}", daemon=True)
         self._thread.start()
         if not self._first.wait(self.settings.timeout) or self._newest is None:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import types
 import typing
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -71,7 +72,7 @@ class Device:
     name: str
     driver: str
     settings: BaseModel
-    opener: Callable[[Any], Any]
+    opener: Callable[..., Any]
 
 
 def load_profile(path: str | Path) -> tuple[str, list[Device]]:
@@ -109,6 +110,11 @@ def _device(role: Role, name: str, entry: DeviceEntry, raw: YamlMap, file: str) 
         raise InputError([Diagnostic(file, mark.line, mark.col, f"{name}: the {entry.driver!r} driver is not part "
                                      "of this version of bearings yet; run in the simulator with --sim")])
     settings = {k: v for k, v in raw.items() if k != "driver"}
+    if role == "camera":
+        settings.setdefault("name", name)  # frames carry the camera's name in the profile
+    calibration = settings.get("calibration")
+    if isinstance(calibration, str) and calibration and not Path(calibration).is_absolute():
+        settings["calibration"] = str(Path(file).parent / calibration)  # relative to the profile, not the cwd
     located = YamlMap(settings)
     located.mark, located.key_marks, located.value_marks = raw.mark, raw.key_marks, raw.value_marks
     try:
@@ -119,7 +125,7 @@ def _device(role: Role, name: str, entry: DeviceEntry, raw: YamlMap, file: str) 
     return Device(role, name, entry.driver, value, opener)
 
 
-def _opener(target: str) -> tuple[Callable[[Any], Any] | None, type[BaseModel] | None]:
+def _opener(target: str) -> tuple[Callable[..., Any] | None, type[BaseModel] | None]:
     """A driver's opener and its declared settings model, or (None, None) when the driver is absent."""
     module_name, _, function = target.partition(":")
     try:
@@ -127,18 +133,25 @@ def _opener(target: str) -> tuple[Callable[[Any], Any] | None, type[BaseModel] |
     except (ModuleNotFoundError, AttributeError):
         return None, None
     hints = typing.get_type_hints(opener)
-    model = hints.get("settings")
-    return opener, model if isinstance(model, type) and issubclass(model, BaseModel) else None
+    declared = hints.get("settings")
+    candidates = typing.get_args(declared) if typing.get_origin(declared) in (typing.Union, types.UnionType) else (
+        declared,)
+    models = [c for c in candidates if isinstance(c, type) and issubclass(c, BaseModel)]
+    return opener, models[0] if models else None
 
 
-def open_robot(path: str | Path) -> Robot:
-    """Open every device of a valid profile; on any failure close what was opened and re-raise."""
+def open_robot(path: str | Path, *, clock: Callable[[], float] | None = None) -> Robot:
+    """Open every device of a valid profile; on any failure close what was opened and re-raise.
+
+    ``clock`` stamps the devices' readings: hand it the run's clock so that odometry and frame
+    stamps are on the time axis the tree sees.
+    """
     name, devices = load_profile(path)
     opened: list[Any] = []
     try:
         base, ptu, cameras = None, None, {}
         for device in devices:
-            handle = device.opener(device.settings)
+            handle = device.opener(device.settings, clock=clock)
             opened.append(handle)
             if device.role == "base":
                 base = handle

@@ -7,8 +7,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from behaviours.clock import TickClock
+from drivers.interfaces import Robot
 from maps.located import validate
 from maps.store import Diagnostic, InputError, output_problem, write_json
+from missions.clocks import Paced, WallClock
 from missions.commands.common import add_mission_options, load_from_args, print_input_error
 from missions.model import RunArguments
 from missions.runner import Runner, RunOptions
@@ -60,18 +63,19 @@ def run(args: argparse.Namespace) -> int:
             numbers = _numbers(args)
             _prepare_outputs(args)
             mission = load_from_args(args.mission, args)
-            simulation, robot = _open(args, numbers.seed)
+            simulation, robot, clock = _open(args, numbers.seed)
         except InputError as exc:
             return print_input_error(exc)
         except Interrupted as exc:
             return _interrupted_early(args, exc.signum)
         try:
-            return _run(args, mission, simulation, robot, numbers)
+            return _run(args, mission, (simulation, robot, clock), numbers)
         finally:
             robot.close()
 
 
-def _run(args: argparse.Namespace, mission: Any, simulation: Any, robot: Any, numbers: RunArguments) -> int:
+def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickClock], numbers: RunArguments) -> int:
+    simulation, robot, clock = opened
     missing = robot.missing_cameras(mission.cameras or ())
     if missing:
         where = args.robot or f"world {args.sim or 'empty'}"
@@ -82,15 +86,9 @@ def _run(args: argparse.Namespace, mission: Any, simulation: Any, robot: Any, nu
         rate_hz=numbers.rate, max_time_s=numbers.max_time, overrun_s=numbers.overrun, report_path=args.report,
         save_path=args.save, progress=not args.quiet and sys.stderr.isatty(), seed=numbers.seed, debug=args.debug,
     )  # fmt: skip
-    if simulation is not None:
-        from missions.clocks import Paced
-
-        clock = simulation.clock()
-        runner = Runner(mission, robot, clock=Paced(clock) if args.realtime else clock, options=options,
-                        observers=[simulation])
-    else:
-        runner = Runner(mission, robot, options=options)
-    result = runner.run()
+    if args.realtime and simulation is not None:
+        clock = Paced(clock)
+    result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else []).run()
     clock_name = "sim" if simulation is not None else "wall"
     print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock_name} time, {result.ticks} ticks "
           f"({result.reason})")
@@ -137,12 +135,14 @@ def _interrupted_early(args: argparse.Namespace, signum: int) -> int:
     return exit_code(signum)
 
 
-def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Any]:
+def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock]:
+    """(simulation or None, robot, the clock the run ticks on)."""
     if args.robot:
         from missions.profiles import open_robot
 
+        clock = WallClock()  # one time axis for the drivers' stamps and the tree
         try:
-            return None, open_robot(args.robot)
+            return None, open_robot(args.robot, clock=clock.now), clock
         except OSError as exc:
             raise InputError([Diagnostic(args.robot, 0, 0, f"cannot open the robot: {exc}")]) from None
     from drivers.sim.simulation import Simulation
@@ -151,4 +151,4 @@ def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Any]:
         simulation = Simulation.load(args.sim, seed=seed)
     except (OSError, ValueError) as exc:  # InputError (a bad world file) passes through as it is
         raise InputError([Diagnostic(str(args.sim), 0, 0, str(exc))]) from None
-    return simulation, simulation.robot
+    return simulation, simulation.robot, simulation.clock()

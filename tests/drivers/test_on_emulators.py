@@ -66,7 +66,7 @@ def test_doctor_fails_with_the_reason(tmp_path, arcos, capsys):
     base = arcos()
     bad = _profile(tmp_path, base.port, extra=", wheels: 4")
     assert main(["doctor", "--robot", str(bad)]) == 2
-    assert "wheels: unknown setting" in capsys.readouterr().err
+    assert "unknown key 'wheels' in base" in capsys.readouterr().err
     base.estop = True
     assert main(["doctor", "--robot", str(_profile(tmp_path, base.port)), "--seconds", "0.1"]) == 0
     assert "warning: the motors are off" in capsys.readouterr().out

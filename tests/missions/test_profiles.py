@@ -11,16 +11,25 @@ from missions.cli import main
 from missions.profiles import PROFILES, load_profile
 
 
-def test_shipped_profile_names_drivers_this_version_lacks(capsys):
-    path = PROFILES / "pioneer-ptu.yaml"
+@pytest.mark.parametrize("path", sorted(PROFILES.glob("*.yaml")), ids=lambda p: p.stem)
+def test_shipped_profiles_are_valid_and_need_their_hardware(path, capsys):
+    name, devices = load_profile(path)
+    assert devices[0].role == "base" and devices[0].driver == "pioneer"
+    assert all(d.settings.name == d.name for d in devices if d.role == "camera")  # frames carry the profile's name
+    assert main(["run", "square", "--robot", str(path), "--quiet"]) == 2  # no robot on this machine
+    err = capsys.readouterr().err
+    assert "cannot open the robot:" in err and "Traceback" not in err
+
+
+def test_driver_settings_errors_are_located_in_the_profile(tmp_path):
+    path = tmp_path / "robot.yaml"
+    path.write_text("base: {driver: pioneer, port: /dev/ttyUSB0, model: p4dx}\n"
+                    "cameras:\n  eye: {driver: opencv, device: 0, fps: 1000}\n")
     with pytest.raises(InputError) as info:
         load_profile(path)
-    messages = [(d.line, d.message) for d in info.value.diagnostics]
-    assert (5, "base: the 'pioneer' driver is not part of this version of bearings yet; run in the simulator "
-               "with --sim") in messages
-    assert len(messages) == 3  # base, ptu and camera
-    assert main(["run", "square", "--robot", str(path), "--quiet"]) == 2
-    assert "Traceback" not in capsys.readouterr().err
+    found = [(d.line, d.message) for d in info.value.diagnostics]
+    assert any(line == 1 and m.startswith("base.model must be one of") for line, m in found), found
+    assert any(line == 3 and m.startswith("cameras.eye.fps must be <= 240 Hz") for line, m in found), found
 
 
 def test_profile_shape_errors(tmp_path):
@@ -52,7 +61,7 @@ def test_driver_settings_are_checked_against_the_opener_declaration(tmp_path, mo
 
     opened = []
 
-    def open_toy(settings: ToySettings):
+    def open_toy(settings: ToySettings, *, clock=None):
         opened.append(settings)
         from drivers.fake import FakeBase
 
