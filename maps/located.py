@@ -46,14 +46,16 @@ def suggest(word: Any, options: Iterable[Any]) -> str:
 
 
 def describe_value(value: Any) -> str:
-    """A value as error messages name it: 'a mapping', 'a list', 'nothing (null)' or its repr."""
+    """A value as error messages name it: 'a mapping', 'a list of 3', 'nothing (null)' or its repr
+    (shortened: a message stays one readable line whatever the file holds)."""
     if isinstance(value, dict):
         return "a mapping"
     if isinstance(value, list):
         return f"a list of {len(value)}"
     if value is None:
         return "nothing (null)"
-    return repr(value)
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:45]}... ({len(text)} characters)"
 
 
 def validate(model: type[M], data: Any, *, file: str, path: tuple[Any, ...] = (),

@@ -13,8 +13,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from drivers.sim.world_file import MAX_COORD
+from maps.located import validate
 from maps.store import InputError, write_bytes_atomic
 from missions.commands.common import EXIT_INVALID, EXIT_OK, fail, print_input_error
+from missions.model import RunArguments
 from perception.geometry import Pose2D
 
 SNAPSHOT_DESCRIPTION = """Render the image a simulated camera sees with the robot at a given TRUE pose, and
@@ -74,8 +77,6 @@ def _help(parser: argparse.ArgumentParser) -> int:
 
 def parse_pose(text: str, named: dict) -> Pose2D:
     """``x,y,theta`` (theta in rad, or degrees with a ``deg`` suffix) or a named pose."""
-    from perception.geometry import Pose2D
-
     if text in named:
         return named[text]
     parts = [p.strip() for p in text.split(",")]
@@ -92,6 +93,8 @@ def parse_pose(text: str, named: dict) -> Pose2D:
         raise ValueError(f"--pose: numbers expected in x,y,theta, got {text!r}") from None
     if not all(math.isfinite(v) for v in (x, y, theta)):
         raise ValueError(f"--pose: finite numbers expected, got {text!r}")
+    if max(abs(x), abs(y)) > MAX_COORD:
+        raise ValueError(f"--pose: x and y must be within {MAX_COORD:g} m (the extent of any world), got {text!r}")
     return Pose2D(x, y, theta)
 
 
@@ -99,6 +102,7 @@ def run_snapshot(args: argparse.Namespace) -> int:
     from drivers.sim.simulation import Simulation
 
     try:
+        validate(RunArguments, {"--seed": args.seed}, file="command line")  # the same range as 'run --seed'
         sim = Simulation.load(args.world, seed=args.seed)
     except InputError as exc:
         return print_input_error(exc)

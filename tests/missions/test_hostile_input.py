@@ -163,3 +163,21 @@ def test_a_report_records_the_zero_velocity_it_ends_with(tmp_path):
     report = tmp_path / "r.json"
     assert main(["run", "square", "--quiet", "--max-time", "3", "--report", str(report)]) == 1
     assert json.loads(report.read_text())["last_command"] == {"v": 0.0, "w": 0.0}
+
+
+@pytest.mark.parametrize(("args", "expected"), [
+    (["--pose", "1e308,1,0"], "--pose: x and y must be within 10000 m"),
+    (["--pose", "1,1,0", "--seed", "-4"], "command line: --seed must be >= 0, got -4"),
+    (["--pose", "nan,1,0"], "--pose: finite numbers expected"),
+    (["--pose", "1,1,0", "--pan", "inf"], "--pan and --tilt must be finite"),
+])
+def test_snapshot_numbers_are_bounded(tmp_path, capsys, args, expected):
+    assert main(["sim", "snapshot", "--world", "lab", *args, "-o", str(tmp_path / "s.png")]) == 2
+    err = capsys.readouterr().err
+    assert expected in err and "Traceback" not in err
+
+
+def test_a_foreign_file_is_named_in_one_short_line(capsys):
+    assert main(["sim", "snapshot", "--world", "/etc/passwd", "--pose", "1,1", "-o", "/tmp/never.png"]) == 2
+    [line, _count] = capsys.readouterr().err.splitlines()
+    assert line.startswith("/etc/passwd:1:1: a world file must be a mapping") and len(line) < 160
