@@ -84,8 +84,12 @@ def mark_of(value: Any, default: Mark | None = None) -> Mark:
     return getattr(value, "mark", None) or default or Mark(0, 0)
 
 
-class _SafeLoader(yaml.SafeLoader):
-    """PyYAML's safe loader, plus YAML 1.2 floats: ``1e-3`` and ``1.0e9`` are numbers, not text."""
+_BASE_LOADER: type = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml parses ~10x faster than pure Python
+
+
+class _SafeLoader(_BASE_LOADER):  # type: ignore[valid-type,misc]
+    """PyYAML's safe loader (libyaml's parser when the wheel has it, as PyPI's do), plus YAML 1.2
+    floats: ``1e-3`` and ``1.0e9`` are numbers, not text."""
 
 
 _SafeLoader.add_implicit_resolver(
