@@ -87,7 +87,7 @@ def mark_of(value: Any, default: Mark | None = None) -> Mark:
 _BASE_LOADER: type = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml parses ~10x faster than pure Python
 
 
-class _SafeLoader(_BASE_LOADER):  # type: ignore[valid-type,misc]
+class _SafeLoader(_BASE_LOADER):
     """PyYAML's safe loader (libyaml's parser when the wheel has it, as PyPI's do), plus YAML 1.2
     floats: ``1e-3`` and ``1.0e9`` are numbers, not text."""
 
