@@ -390,11 +390,12 @@ class LandmarkTree:
         return found
 
     def match(self, index: int, observation: Observation, *, bearings: np.ndarray | None = None,
-              ratio: float | None = None) -> LandmarkMatches:
-        """Match an observation against viewframe ``index`` (cached): ``ref`` the viewframe's bearings,
-        ``cur`` the observation's (``bearings`` replaces them, e.g. compensated), ``landmark``
-        indexes the viewframe (``viewframe(index).landmarks[m.landmark]`` are map indices)."""
-        found = self.viewframe(index)
+              ratio: float | None = None, cached: bool = True) -> LandmarkMatches:
+        """Match an observation against viewframe ``index``: ``ref`` the viewframe's bearings, ``cur``
+        the observation's (``bearings`` replaces them, e.g. compensated), ``landmark`` indexes the
+        viewframe (``viewframe(index).landmarks[m.landmark]`` are map indices). ``cached=False``
+        builds the viewframe's stack again (only to measure what the cache saves)."""
+        found = self.viewframe(index, cached=cached)
         cur = np.asarray(observation.bearings if bearings is None else bearings, dtype=np.float64).reshape(-1, 3)
         if self.kind == IDS:
             if observation.ids is None:
@@ -897,6 +898,10 @@ class RouteLearner:
         if tracked is not None:
             landmarks, features = tracked.landmarks, tracked.matches.feature
         new = np.setdiff1d(stable, features)
+        if len(new) == 0 and len(landmarks) == 0:  # nothing seen (a blind spell): no empty viewframes
+            self._at_viewframe = False
+            return LearnStep(tree.viewframe_count - 1, False, float(change), count,
+                             volatile=seen.observation.count - len(stable))
         before = tree.landmark_count
         sightings = LandmarkSet.from_observation(seen.observation, seen.bearings, features)
         tree.add_viewframe(landmarks, sightings, LandmarkSet.from_observation(seen.observation, seen.bearings, new),

@@ -24,7 +24,6 @@ from typing import Any
 import numpy as np
 
 from maps.ltmap import IDS, LandmarkTree, RouteLearner
-from perception.matching import match_landmarks
 from perception.observation import Observation
 from perception.synthetic_route import make_route_world, observe_route, straight_route
 
@@ -55,14 +54,6 @@ def _teach(kind: str, length: float) -> tuple[LandmarkTree, list[Observation], f
     return learner.tree, at_viewframe, round(elapsed * 1e3, 4)
 
 
-def _rebuilt_match(tree: LandmarkTree, index: int, observation: Observation) -> None:
-    found = tree.viewframe(index, cached=False)
-    if tree.kind == IDS:
-        np.intersect1d(observation.ids, found.ids, return_indices=True)
-    else:
-        match_landmarks(observation.features, observation.bearings, found.matchable)
-
-
 def _figures(kind: str, length: float, repeats: int) -> dict[str, Any]:
     tree, observations, learn_ms = _teach(kind, length)
     sample = np.linspace(0, tree.viewframe_count - 1, min(8, tree.viewframe_count)).astype(int)
@@ -70,7 +61,7 @@ def _figures(kind: str, length: float, repeats: int) -> dict[str, Any]:
     for i in sample:
         tree.match(int(i), observations[i])  # warm the cache, as following does after its first tick
         cached.append(_median_ms(lambda i=int(i): tree.match(i, observations[i]), repeats))
-        rebuilt.append(_median_ms(lambda i=int(i): _rebuilt_match(tree, i, observations[i]), repeats))
+        rebuilt.append(_median_ms(lambda i=int(i): tree.match(i, observations[i], cached=False), repeats))
     summary = tree.summary()
     per_height = [tree.memory_bytes()]
     pruned = tree.copy()
