@@ -8,7 +8,7 @@ import pytest
 from maps.ltmap import IDS, LearnConfig, RouteLearner, threshold_angle
 from perception.geometry import Pose2D
 from perception.observation import Observation
-from perception.similarity import DEFAULT_SCALE, bearing_angles
+from perception.similarity import DEFAULT_SCALE, bearing_angles, delta_t
 from perception.synthetic import unit
 from perception.synthetic_route import (
     CLUTTER_ID_BASE,
@@ -17,6 +17,7 @@ from perception.synthetic_route import (
     straight_route,
     visible,
 )
+from perception.zinf import estimate_motion
 
 WORLD = make_route_world(0, length=6.0, n_far=60, n_near=500)
 
@@ -87,6 +88,19 @@ def test_viewframes_hold_what_was_seen_from_their_place(corridor):
         assert np.mean(error < share + np.radians(0.5)) > 0.97
 
 
+def test_following_can_switch_at_every_viewframe(corridor):
+    # at a viewframe's own place, turned, eq. 1 against it (de-rotated by Z-infinity) is under the
+    # threshold: shared landmarks keep bearings within share_angle, so the switch rule can fire
+    learner, _, places = corridor
+    rng = np.random.default_rng(8)
+    for index, place in enumerate(places):
+        observation = observe_route(WORLD, Pose2D(place.x, place.y, 0.6), rng, noise_deg=0.1, dropout=0.05)
+        matched = learner.tree.match(index, observation)
+        motion = estimate_motion(matched.ref, matched.cur)
+        assert motion.rotation_ok and abs(motion.yaw + 0.6) < np.radians(1.0)
+        assert delta_t(matched.ref, matched.cur, rotation=motion.rotation) < learner.tree.threshold / 2
+
+
 def test_volatile_landmarks_never_enter_the_map(corridor):
     learner, steps, _ = corridor
     assert learner.tree.ids.max() < CLUTTER_ID_BASE
@@ -114,7 +128,7 @@ def test_far_landmarks_are_stored_once_at_the_root_and_local_ones_in_the_leaves(
     learner, _, _ = teach(straight_route(6.0, 0.05), noise_deg=0.05)
     tree = learner.tree
     far = np.flatnonzero(WORLD.far)
-    root = tree.node_landmarks(tree.branch_nodes(0)[0])
+    root = tree.node_landmarks(tree.root)
     assert set(far) <= set(tree.ids[root])
     assert np.array_equal(np.sort(tree.ids[np.isin(tree.ids, far)]), far), "stored once"
     depth = tree.depths()[tree.landmark_nodes]
