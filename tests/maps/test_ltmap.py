@@ -18,7 +18,7 @@ from perception.similarity import bearing_angles
 from perception.synthetic import unit
 
 SHARE = 0.05  # rad: the gate of the random sequences
-SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
 class Rows:
