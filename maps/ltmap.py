@@ -243,24 +243,18 @@ def attach_level(lost: np.ndarray, tracked: np.ndarray, leaves: np.ndarray) -> i
 
 @dataclass
 class _Rows:
-    """The landmark rows of a tree: node, unit bearing, descriptor or id (mutable storage)."""
+    """The landmark rows of a tree (mutable storage): node, unit bearing, and ``data``, the
+    descriptor row (N x W) or the id (N,) depending on the tree's kind."""
 
     node: np.ndarray
     bearings: np.ndarray
-    descriptors: np.ndarray | None
-    ids: np.ndarray | None
-
-    @property
-    def data(self) -> np.ndarray:
-        return self.ids if self.ids is not None else self.descriptors
+    data: np.ndarray
 
     def take(self, index: np.ndarray) -> _Rows:
-        return _Rows(self.node[index], self.bearings[index],
-                     None if self.descriptors is None else self.descriptors[index],
-                     None if self.ids is None else self.ids[index])
+        return _Rows(self.node[index], self.bearings[index], self.data[index])
 
     def copy(self) -> _Rows:
-        return _Rows(*(None if a is None else a.copy() for a in (self.node, self.bearings, self.descriptors, self.ids)))
+        return _Rows(self.node.copy(), self.bearings.copy(), self.data.copy())
 
 
 class LandmarkTree:
@@ -346,11 +340,11 @@ class LandmarkTree:
 
     @property
     def descriptors(self) -> np.ndarray | None:
-        return None if self._rows.descriptors is None else _readonly(self._rows.descriptors)
+        return None if self.kind == IDS else _readonly(self._rows.data)
 
     @property
     def ids(self) -> np.ndarray | None:
-        return None if self._rows.ids is None else _readonly(self._rows.ids)
+        return _readonly(self._rows.data) if self.kind == IDS else None
 
     @property
     def landmark_nodes(self) -> np.ndarray:
@@ -398,29 +392,26 @@ class LandmarkTree:
         builds the viewframe's stack again (only to measure what the cache saves)."""
         found = self.viewframe(index, cached=cached)
         cur = np.asarray(observation.bearings if bearings is None else bearings, dtype=np.float64).reshape(-1, 3)
-        if self.kind == IDS:
+        if found.ids is not None:
             if observation.ids is None:
                 raise ValueError("this map holds landmark ids; the observation has descriptors")
-            return _match_ids(np.asarray(observation.ids), cur, found)
-        if observation.features is None:
+            return _match_ids(np.asarray(observation.ids), found.ids, cur, found.bearings)
+        if observation.features is None or found.matchable is None:
             raise ValueError(f"this map holds {self.kind} descriptors; the observation has landmark ids")
         return match_landmarks(observation.features, cur, found.matchable, ratio=ratio)
 
     def _build_viewframe(self, index: int) -> Viewframe:
         landmarks = np.flatnonzero(np.isin(self._rows.node, self.branch_nodes(index)))
-        ids = None
-        if self._rows.ids is not None:  # one row per id: the deepest (most local) copy, sorted by id
+        if self.kind == IDS:  # one row per id: the deepest (most local) copy, sorted by id
             depth = self.depths()[self._rows.node[landmarks]]
-            order = np.lexsort((-depth, self._rows.ids[landmarks]))
-            _, first = np.unique(self._rows.ids[landmarks[order]], return_index=True)
+            order = np.lexsort((-depth, self._rows.data[landmarks]))
+            _, first = np.unique(self._rows.data[landmarks[order]], return_index=True)
             landmarks = landmarks[order[first]]
-            ids = _readonly(self._rows.ids[landmarks])
         bearings = _readonly(self._rows.bearings[landmarks].astype(np.float64))
-        descriptors = matchable = None
-        if self._rows.descriptors is not None:
-            descriptors = _readonly(np.ascontiguousarray(self._rows.descriptors[landmarks]))
-            matchable = Landmarks(descriptors, bearings, self.kind)
-        return Viewframe(index, _readonly(landmarks), bearings, descriptors, ids, matchable)
+        data = _readonly(np.ascontiguousarray(self._rows.data[landmarks]))
+        if self.kind == IDS:
+            return Viewframe(index, _readonly(landmarks), bearings, None, data, None)
+        return Viewframe(index, _readonly(landmarks), bearings, data, None, Landmarks(data, bearings, self.kind))
 
     # ----- learning ---------------------------------------------------------------------------
 
@@ -510,10 +501,9 @@ class LandmarkTree:
         rows.node = np.concatenate((rows.node, np.full(len(new), node, dtype=np.int64)))
         bearings = _unit(np.asarray(new.bearings).reshape(-1, 3)).astype(BEARING_DTYPE)
         rows.bearings = np.concatenate((rows.bearings, bearings))
-        if rows.ids is not None:
-            rows.ids = np.concatenate((rows.ids, np.asarray(new.ids, dtype=ID_DTYPE).ravel()))
-        else:
-            rows.descriptors = np.concatenate((rows.descriptors, np.asarray(new.descriptors, rows.descriptors.dtype)))
+        data = new.ids if self.kind == IDS else new.descriptors
+        data = np.asarray(data, dtype=rows.data.dtype).reshape(-1, *rows.data.shape[1:])
+        rows.data = np.concatenate((rows.data, data))
 
     # ----- pruning ----------------------------------------------------------------------------
 
@@ -544,7 +534,7 @@ class LandmarkTree:
         if budget_bytes < 0:
             raise ValueError(f"budget must be >= 0 bytes, got {budget_bytes}")
         before = self.memory_bytes()
-        work, steps = self.copy(), []
+        work, steps = self.copy(), list[PruneStep]()
         index = np.arange(self.landmark_count)
         while work.memory_bytes() > budget_bytes:
             step = work.prune_level(min_landmarks)
@@ -626,7 +616,7 @@ class LandmarkTree:
         parent, size, leaves = _checked_structure(arrays, len(data))
         node = np.repeat(np.arange(len(parent), dtype=np.int64), size)
         tree._parent, tree._leaves = [int(p) for p in parent], [int(v) for v in leaves]
-        tree._rows = _Rows(node, bearings, None if kind == IDS else data, data if kind == IDS else None)
+        tree._rows = _Rows(node, bearings, data)
         return tree
 
 
@@ -634,15 +624,17 @@ def _empty_rows(kind: str) -> _Rows:
     node = np.zeros(0, dtype=np.int64)
     bearings = np.zeros((0, 3), dtype=BEARING_DTYPE)
     if kind == IDS:
-        return _Rows(node, bearings, None, np.zeros(0, dtype=ID_DTYPE))
+        return _Rows(node, bearings, np.zeros(0, dtype=ID_DTYPE))
     width, dtype = DESCRIPTOR_KINDS[kind]
-    return _Rows(node, bearings, np.zeros((0, width), dtype=dtype), None)
+    return _Rows(node, bearings, np.zeros((0, width), dtype=dtype))
 
 
-def _match_ids(ids: np.ndarray, cur: np.ndarray, found: Viewframe) -> LandmarkMatches:
-    _, feature, landmark = np.intersect1d(ids, found.ids, return_indices=True)
+def _match_ids(ids: np.ndarray, stored: np.ndarray, cur: np.ndarray, ref: np.ndarray) -> LandmarkMatches:
+    """Correspondences by equal ids (the ideal sensor): observed ``ids`` with bearings ``cur``
+    against ``stored`` ids with bearings ``ref``."""
+    _, feature, landmark = np.intersect1d(ids, stored, return_indices=True)
     feature, landmark = feature.astype(np.int64), landmark.astype(np.int64)
-    return LandmarkMatches(ref=found.bearings[landmark], cur=cur[feature], feature=feature, landmark=landmark,
+    return LandmarkMatches(ref=ref[landmark], cur=cur[feature], feature=feature, landmark=landmark,
                            distance=np.zeros(len(feature)))
 
 
@@ -679,15 +671,15 @@ def _preorder(parent: np.ndarray, alive: np.ndarray, ends: Sequence[int]) -> lis
             first[n] = k
             n = parent[n]
     children: dict[int, list[int]] = {}
-    roots = []
-    for n in np.flatnonzero(alive):
-        (roots if parent[n] < 0 else children.setdefault(int(parent[n]), [])).append(int(n))
+    roots: list[int] = []
+    for n in np.flatnonzero(alive).tolist():
+        (roots if parent[n] < 0 else children.setdefault(int(parent[n]), [])).append(n)
     order: list[int] = []
-    stack = sorted(roots, key=lambda n: -first[n])
+    stack = sorted(roots, key=lambda n: -int(first[n]))
     while stack:
-        n = stack.pop()
-        order.append(n)
-        stack.extend(sorted(children.get(n, ()), key=lambda c: -first[c]))
+        node = stack.pop()
+        order.append(node)
+        stack.extend(sorted(children.get(node, ()), key=lambda c: -int(first[c])))
     return order
 
 
@@ -858,33 +850,36 @@ class RouteLearner:
         """One new observation, seen with the camera at ``heading`` (rad) in the route frame."""
         if self.tree is None:
             self.tree = LandmarkTree(_kind_of(observation), threshold=self.config.threshold)
-        self._before, self._latest = self._latest, _Seen(observation, compensate(observation.bearings, heading))
-        if self.tree.viewframe_count == 0:
-            self._at_viewframe = self._before is not None
-            return self._make_viewframe(np.inf, 0) if self._at_viewframe else LearnStep(-1, False, np.inf, 0)
-        tracked = self._track()
+        tree, seen = self.tree, _Seen(observation, compensate(observation.bearings, heading))
+        self._before, self._latest = self._latest, seen
+        if tree.viewframe_count == 0:
+            self._at_viewframe = self._before is not None  # the first viewframe needs a previous image
+            if not self._at_viewframe:
+                return LearnStep(-1, False, np.inf, 0)
+            return self._make_viewframe(tree, seen, np.inf, 0)
+        tracked = self._track(tree, seen)
         change, count = self._change(tracked)
         self._at_viewframe = change > self.config.threshold
         if self._at_viewframe:
-            return self._make_viewframe(change, count, tracked)
-        return LearnStep(self.tree.viewframe_count - 1, False, change, count)
+            return self._make_viewframe(tree, seen, change, count, tracked)
+        return LearnStep(tree.viewframe_count - 1, False, change, count)
 
     def finish(self) -> LearnStep:
         """Make the latest observation's place the last viewframe (the goal), unless it already is."""
-        if self._latest is None or self.tree is None:
+        tree, seen = self.tree, self._latest
+        if seen is None or tree is None:
             raise ValueError("nothing was observed: there is no route to finish")
         if self._at_viewframe:
-            return LearnStep(self.tree.viewframe_count - 1, False, 0.0, 0)
+            return LearnStep(tree.viewframe_count - 1, False, 0.0, 0)
         self._at_viewframe = True
-        if self.tree.viewframe_count == 0:
-            return self._make_viewframe(np.inf, 0)
-        tracked = self._track()
-        return self._make_viewframe(*self._change(tracked), tracked)
+        if tree.viewframe_count == 0:
+            return self._make_viewframe(tree, seen, np.inf, 0)
+        tracked = self._track(tree, seen)
+        return self._make_viewframe(tree, seen, *self._change(tracked), tracked)
 
-    def _track(self) -> _Tracked:
-        seen = self._latest
-        matches = self.tree.match(-1, seen.observation, bearings=seen.bearings, ratio=self.config.ratio)
-        return _Tracked(matches, self.tree.viewframe(-1).landmarks[matches.landmark])
+    def _track(self, tree: LandmarkTree, seen: _Seen) -> _Tracked:
+        matches = tree.match(-1, seen.observation, bearings=seen.bearings, ratio=self.config.ratio)
+        return _Tracked(matches, tree.viewframe(-1).landmarks[matches.landmark])
 
     def _change(self, tracked: _Tracked) -> tuple[float, int]:
         """Eq. 1 over the landmarks tracked since the last viewframe, from their bearings then."""
@@ -892,17 +887,17 @@ class RouteLearner:
         change = delta_t(self._anchor.bearings[then], tracked.matches.cur[now], scale=self.config.scale)  # eq. 1
         return change, len(then)
 
-    def _make_viewframe(self, change: float, count: int, tracked: _Tracked | None = None) -> LearnStep:
-        tree, seen = self.tree, self._latest
-        stable = self._stable()
+    def _make_viewframe(self, tree: LandmarkTree, seen: _Seen, change: float, count: int,
+                        tracked: _Tracked | None = None) -> LearnStep:
+        stable = self._stable(seen)
         landmarks, features = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
         if tracked is not None:
             landmarks, features = tracked.landmarks, tracked.matches.feature
         new = np.setdiff1d(stable, features)
+        volatile = seen.observation.count - len(stable)
         if len(new) == 0 and len(landmarks) == 0:  # nothing seen (a blind spell): no empty viewframes
             self._at_viewframe = False
-            return LearnStep(tree.viewframe_count - 1, False, float(change), count,
-                             volatile=seen.observation.count - len(stable))
+            return LearnStep(tree.viewframe_count - 1, False, float(change), count, volatile=volatile)
         before = tree.landmark_count
         sightings = LandmarkSet.from_observation(seen.observation, seen.bearings, features)
         tree.add_viewframe(landmarks, sightings, LandmarkSet.from_observation(seen.observation, seen.bearings, new),
@@ -910,30 +905,29 @@ class RouteLearner:
         stored = np.arange(before, tree.landmark_count)
         self._anchor = _Anchor(np.concatenate((landmarks, stored)),
                                np.vstack((sightings.bearings, tree.bearings[stored])))
-        pruned = self._prune_online()
-        return LearnStep(tree.viewframe_count - 1, True, float(change), count, len(stored),
-                         seen.observation.count - len(stable), pruned)
+        pruned = self._prune_online(tree)
+        return LearnStep(tree.viewframe_count - 1, True, float(change), count, len(stored), volatile, pruned)
 
-    def _prune_online(self) -> PruneReport | None:
+    def _prune_online(self, tree: LandmarkTree) -> PruneReport | None:
         budget = self.config.budget_bytes
-        if budget is None or self.tree.memory_bytes() <= budget:
+        if budget is None or tree.memory_bytes() <= budget:
             return None
-        report = self.tree.prune_to(budget, self.config.min_landmarks)
+        report = tree.prune_to(budget, self.config.min_landmarks)
         index = report.landmark_index[self._anchor.landmarks]
         self._anchor = _Anchor(index[index >= 0], self._anchor.bearings[index >= 0])
         return report
 
-    def _stable(self) -> np.ndarray:
-        """Indices of the latest observation's landmarks also seen in the previous image (not volatile)."""
-        cur = self._latest.observation
+    def _stable(self, seen: _Seen) -> np.ndarray:
+        """Indices of the observation's landmarks also seen in the previous image (not volatile)."""
+        cur = seen.observation
         if self._before is None:
             return np.arange(cur.count)
         previous = self._before.observation
-        if (cur.ids is None) != (previous.ids is None):
-            raise ValueError("observations mix landmark ids and descriptors")
-        if cur.ids is not None:
+        if cur.ids is not None and previous.ids is not None:
             return np.sort(np.intersect1d(cur.ids, previous.ids, return_indices=True)[1]).astype(np.int64)
-        return np.sort(match_features(cur.features, previous.features, ratio=self.config.ratio).query)
+        if cur.features is not None and previous.features is not None:
+            return np.sort(match_features(cur.features, previous.features, ratio=self.config.ratio).query)
+        raise ValueError("observations mix landmark ids and descriptors")
 
 
 def _kind_of(observation: Observation) -> str:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -51,6 +52,8 @@ def _teach(kind: str, length: float) -> tuple[LandmarkTree, list[Observation], f
     if learner.finish().created:
         at_viewframe.append(observation)
     elapsed = (time.perf_counter() - start) / len(poses)
+    if learner.tree is None:
+        raise RuntimeError("the benchmark route taught nothing")
     return learner.tree, at_viewframe, round(elapsed * 1e3, 4)
 
 
@@ -60,8 +63,8 @@ def _figures(kind: str, length: float, repeats: int) -> dict[str, Any]:
     cached, rebuilt = [], []
     for i in sample:
         tree.match(int(i), observations[i])  # warm the cache, as following does after its first tick
-        cached.append(_median_ms(lambda i=int(i): tree.match(i, observations[i]), repeats))
-        rebuilt.append(_median_ms(lambda i=int(i): tree.match(i, observations[i], cached=False), repeats))
+        cached.append(_median_ms(partial(tree.match, int(i), observations[i]), repeats))
+        rebuilt.append(_median_ms(partial(tree.match, int(i), observations[i], cached=False), repeats))
     summary = tree.summary()
     per_height = [tree.memory_bytes()]
     pruned = tree.copy()
