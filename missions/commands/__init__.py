@@ -13,4 +13,5 @@ COMMANDS = (
     "missions.commands.sim",
     "missions.commands.calibrate",
     "missions.commands.doctor",
+    "missions.commands.map",
 )

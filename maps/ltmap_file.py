@@ -1,0 +1,68 @@
+"""LT-map files: a :class:`~maps.ltmap.LandmarkTree` saved as map kind ``ltmap``, format version 1.
+
+The container (magic line, JSON header with length and SHA-256, ``.npz`` payload, atomic write)
+is :mod:`maps.mapfile`'s; the payload holds exactly :meth:`LandmarkTree.to_arrays`, so a map's
+``memory_bytes()`` is what its arrays take in the file, and the header's ``meta`` holds what is
+not an array: the landmark kind and the eq. 1 threshold the route was taught with (route
+following switches viewframes at the same value). A damaged, truncated, foreign or inconsistent
+file is one :class:`~maps.store.InputError` line, and a failed save leaves the previous file.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from maps.ltmap import LandmarkTree
+from maps.mapfile import MapFile, decode_map, encode_map, read_map_file, write_map_file
+from maps.store import Diagnostic, InputError
+
+KIND = "ltmap"
+VERSION = 1
+
+
+class LtmapMeta(BaseModel):
+    """The ``meta`` of an LT-map file header."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    landmarks: Literal["ids", "orb", "brisk", "sift"] = Field(description="descriptor kind, or ids (ideal sensor)")
+    threshold: float = Field(gt=0, allow_inf_nan=False, description="eq. 1 threshold the route was taught with [rad^2]")
+
+
+def _meta(tree: LandmarkTree) -> dict:
+    return LtmapMeta(landmarks=tree.kind, threshold=tree.threshold).model_dump()
+
+
+def encode_ltmap(tree: LandmarkTree) -> bytes:
+    """The bytes of an LT-map file (what :func:`save_ltmap` writes)."""
+    return encode_map(kind=KIND, version=VERSION, arrays=tree.to_arrays(), meta=_meta(tree))
+
+
+def save_ltmap(path: str | os.PathLike, tree: LandmarkTree) -> None:
+    """Save atomically: ``path`` holds either its previous content or all of this map."""
+    write_map_file(path, kind=KIND, version=VERSION, arrays=tree.to_arrays(), meta=_meta(tree))
+
+
+def decode_ltmap(data: bytes, *, file: str) -> LandmarkTree:
+    """An LT-map from file bytes; one-line :class:`InputError` naming ``file`` when they are not one."""
+    return _tree(decode_map(data, file=file, kind=KIND, versions=(VERSION,)), file)
+
+
+def load_ltmap(path: str | os.PathLike) -> LandmarkTree:
+    """Load an LT-map file, checking container, header and the tree's consistency."""
+    return _tree(read_map_file(path, kind=KIND, versions=(VERSION,)), str(path))
+
+
+def _tree(loaded: MapFile, file: str) -> LandmarkTree:
+    try:
+        meta = LtmapMeta.model_validate(loaded.meta)
+    except ValidationError as exc:
+        where = ".".join(str(part) for part in exc.errors()[0]["loc"]) or "meta"
+        raise InputError([Diagnostic(file, 0, 0, f"damaged LT-map: bad header meta ({where})")]) from None
+    try:
+        return LandmarkTree.from_arrays(loaded.arrays, kind=meta.landmarks, threshold=meta.threshold)
+    except ValueError as exc:
+        raise InputError([Diagnostic(file, 0, 0, f"damaged LT-map: {exc}")]) from None
