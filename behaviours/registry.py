@@ -37,7 +37,9 @@ Kind = Literal["action", "condition", "decorator", "composite"]
 KINDS: tuple[Kind, ...] = ("action", "condition", "decorator", "composite")
 ENTRY_POINT_GROUP = "bearings.behaviours"
 BUILTIN_MODULES = ("behaviours.control", "behaviours.composites", "behaviours.decorators", "behaviours.motion",
-                   "behaviours.wait", "behaviours.conditions", "behaviours.perceive")
+                   "behaviours.wait", "behaviours.conditions", "behaviours.perceive", "behaviours.landmark_tree",
+                   "behaviours.teach", "behaviours.route", "behaviours.search", "behaviours.teleop",
+                   "behaviours.waypoints")
 _MARK = "__bearings_node_type__"
 
 
