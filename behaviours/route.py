@@ -143,7 +143,7 @@ def lost_threshold(viewframe_size: int, min_matches: int) -> int:
     return max(ZINF_MIN_LANDMARKS, math.ceil(viewframe_size / 2) if small else min_matches)
 
 
-FAR_THRESHOLDS = tuple(np.radians((1.0, 2.0, 4.0)))  # rad: "unmoved after rotation", tightest first
+FAR_THRESHOLDS = tuple(np.radians((1.0, 2.0, 4.0, 8.0)))  # rad: "unmoved after rotation", tightest first
 
 
 def zinf_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> ZinfResult:
