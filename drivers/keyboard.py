@@ -56,8 +56,12 @@ class TerminalKeys:
         import termios
         import tty
 
-        self.fd = sys.stdin.fileno() if fd is None else fd
-        if not os.isatty(self.fd):
+        try:
+            self.fd = sys.stdin.fileno() if fd is None else fd
+            terminal = os.isatty(self.fd)
+        except (OSError, ValueError, AttributeError):  # a replaced or closed stdin has no descriptor
+            terminal = False
+        if not terminal:
             raise OSError("standard input is not a terminal: run the mission from a terminal to drive with keys")
         self._termios = termios
         self._saved = termios.tcgetattr(self.fd)
