@@ -146,20 +146,25 @@ def lost_threshold(viewframe_size: int, min_matches: int) -> int:
 FAR_THRESHOLDS = tuple(np.radians((1.0, 2.0, 4.0, 8.0)))  # rad: "unmoved after rotation", tightest first
 
 
-def zinf_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> ZinfResult:
+def zinf_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> tuple[ZinfResult, bool]:
     """Z-infinity (eqs. 2-6) with the tightest far threshold that separates a rotation.
 
     Indoors few landmarks are far enough to move less than 1 degree over the tens of centimetres
     between viewframes (and the ideal sensor's noise alone moves a bearing by that much): with
-    no far set at 1 degree, the estimate is tried again at 2 and 4 degrees, the farthest
-    landmarks there are then standing in for the ones at infinity.
+    no far set at 1 degree, the estimate is tried again at 2, 4 and 8 degrees, the farthest
+    landmarks there standing in for the ones at infinity. When none separates a rotation (a
+    pruned viewframe with few landmarks left), the rotation of all matched landmarks (a compass,
+    :func:`compass_motion`) keeps the robot going rather than stopping it. Returns the estimate
+    and whether it is that compass.
     """
     motion = estimate_motion(ref, cur, rng=rng, far_threshold=FAR_THRESHOLDS[0])
     for threshold in FAR_THRESHOLDS[1:]:
         if motion.status is not ZinfStatus.NO_ROTATION:
-            break
+            return motion, False
         motion = estimate_motion(ref, cur, rng=rng, far_threshold=threshold)
-    return motion
+    if motion.status is ZinfStatus.NO_ROTATION:
+        return compass_motion(ref, cur, rng), True
+    return motion, False
 
 
 def compass_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> ZinfResult:
@@ -308,11 +313,12 @@ class FollowRoute(BearingsBehaviour):
         if len(matches) < needed:
             return RouteEstimate(target, observation.stamp, len(matches), "lost", math.inf, nan, nan, 0.0)
         if self.get_input("rotation") == "compass":
-            motion = compass_motion(matches.ref, matches.cur, self._rng)
+            motion, fallback = compass_motion(matches.ref, matches.cur, self._rng), False
         else:
-            motion = zinf_motion(matches.ref, matches.cur, self._rng)  # eqs. 2-6
+            motion, fallback = zinf_motion(matches.ref, matches.cur, self._rng)  # eqs. 2-6
+        status = f"compass, {motion.status.value}" if fallback else motion.status.value
         if not motion.rotation_ok:
-            return RouteEstimate(target, observation.stamp, len(matches), motion.status.value, math.inf, nan, nan, 0.0)
+            return RouteEstimate(target, observation.stamp, len(matches), status, math.inf, nan, nan, 0.0)
         weights = motion.inliers.astype(np.float64) if motion.inliers.any() else None
         change = delta_t(matches.ref, matches.cur, rotation=motion.rotation, weights=weights)  # eq. 1
         if motion.ok:
@@ -320,9 +326,9 @@ class FollowRoute(BearingsBehaviour):
             self._filter = self._filter.push(math.atan2(home[1], home[0]), motion.confidence)
         heading = self._filter.heading  # eqs. 7-8: circular median of the last K
         if heading is None:
-            return RouteEstimate(target, observation.stamp, len(matches), motion.status.value, change, nan, nan, 0.0)
+            return RouteEstimate(target, observation.stamp, len(matches), status, change, nan, nan, 0.0)
         error = wrap_angle(heading + motion.yaw)  # the robot's heading in the viewframe's frame is -yaw
-        return RouteEstimate(target, observation.stamp, len(matches), motion.status.value, change, heading, error,
+        return RouteEstimate(target, observation.stamp, len(matches), status, change, heading, error,
                              self._filter.confidence)
 
     def _steer(self, estimate: RouteEstimate) -> VelocityCommand:

@@ -23,12 +23,19 @@ from behaviours.landmark_tree import LTMAP_IN
 from behaviours.motion import COMMAND, ODOMETRY, STALLED
 from behaviours.ports import InputPort, OutputPort
 from behaviours.registry import register
-from behaviours.route import MIN_MATCHES, OBSERVATION_IN, PROGRESS_IN, PROGRESS_KEY, RouteProgress, lost_threshold
+from behaviours.route import (
+    MIN_MATCHES,
+    OBSERVATION_IN,
+    PROGRESS_IN,
+    PROGRESS_KEY,
+    RouteProgress,
+    lost_threshold,
+    zinf_motion,
+)
 from drivers.interfaces import STOP, VelocityCommand
 from maps.ltmap import LandmarkTree
 from perception.geometry import Pose2D, wrap_angle
 from perception.observation import Observation
-from perception.zinf import estimate_motion
 
 
 def lying_eight(width: float, points: int = 64) -> np.ndarray:
@@ -63,6 +70,7 @@ class SearchPattern(BearingsBehaviour):
         super().__init__(name=name, **ports)
         self.recoveries = 0
         self.found_again = 0
+        self._rng = np.random.default_rng(0)
         self._origin: Pose2D | None = None
         self._logged_origin: Pose2D | None = None
         self._last_theta, self._turned = 0.0, 0.0
@@ -121,7 +129,7 @@ class SearchPattern(BearingsBehaviour):
             matches = tree.match(index, observation)
             if len(matches) < lost_threshold(len(tree.viewframe(index)), int(self.get_input("min_matches"))):
                 continue
-            if estimate_motion(matches.ref, matches.cur, rng=0).rotation_ok:
+            if zinf_motion(matches.ref, matches.cur, self._rng)[0].rotation_ok:
                 self.set_output("found", progress.retargeted(index, self.now()))
                 self.found_again += 1
                 self.feedback_message = f"the trail is found again at viewframe {index}"
