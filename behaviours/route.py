@@ -10,7 +10,8 @@ nodes rather than in one behaviour:
   directions is steered along (eqs. 7-8), the speed scales with the estimate's confidence
   (eq. 9). It publishes a :class:`RouteEstimate` (``/map/route_estimate``) every new observation,
   and fails when fewer than ``min_matches`` landmarks match the viewframe for ``lost_time``
-  (the trail is lost: a recovery, ``SearchPattern``, takes over).
+  (the trail is lost: a recovery, ``SearchPattern``, takes over); over a shorter gap it keeps the
+  last command, so a few frames with too few matches between two viewframes do not stop it.
 - :class:`ViewframeSwitch` moves the target on when ``delta_t`` (eq. 1) against it falls under
   the map's threshold, or when the direction to it flips by more than 90 degrees (it was
   passed), the second rule blocked after each switch for as long as a 180 degree turn takes
@@ -224,7 +225,7 @@ class FollowRoute(BearingsBehaviour):
 
     RUNNING while it follows (it never ends by itself: :class:`ViewframeSwitch` ends the route);
     FAILURE when the trail is lost (fewer than ``min_matches`` landmarks match, or no usable
-    estimate, for ``lost_time``) or the base is stalled. Writes the velocity to ``command`` and
+    estimate, for ``lost_time``; until then it keeps the last command) or the base is stalled. Writes the velocity to ``command`` and
     a :class:`RouteEstimate` per new observation to ``estimate``.
     """
 
@@ -259,7 +260,7 @@ class FollowRoute(BearingsBehaviour):
         self._target: int | None = None
         self._stamp: float | None = None
         self._lost_since: float | None = None
-        self._command = STOP
+        self._command = self._coast = STOP
 
     def initialise(self) -> None:
         self._reset()
@@ -290,6 +291,7 @@ class FollowRoute(BearingsBehaviour):
         estimate = self.estimate
         if estimate is not None and estimate.usable:
             self._lost_since = None
+            self._coast = self._command
             self.set_output("command", self._command)
             self.feedback_message = (f"viewframe {estimate.viewframe}: {estimate.matched} matched, "
                                      f"error {math.degrees(estimate.error):+.0f} deg")
@@ -299,8 +301,10 @@ class FollowRoute(BearingsBehaviour):
         matched = estimate.matched if estimate is not None else 0
         self.feedback_message = f"lost: {matched} landmarks match viewframe {self._target}" + (
             f" ({estimate.status})" if estimate is not None else "")
-        return self._stop(Status.FAILURE if now - self._lost_since >= float(self.get_input("lost_time"))
-                          else Status.RUNNING)
+        if now - self._lost_since >= float(self.get_input("lost_time")):
+            return self._stop(Status.FAILURE)
+        self.set_output("command", self._coast)  # a short gap: keep on as before (STOP before any estimate)
+        return Status.RUNNING
 
     def _stop(self, status: Status) -> Status:
         self.set_output("command", STOP)

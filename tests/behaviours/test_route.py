@@ -83,7 +83,7 @@ def test_follow_route_heading_ignores_the_robots_own_rotation():
     assert harness.read("/robot/command").v == 0.0  # turns on the spot first
 
 
-def test_follow_route_fails_when_lost_for_lost_time_and_stops_meanwhile():
+def test_follow_route_fails_when_lost_for_lost_time_and_keeps_its_last_command_meanwhile():
     harness = follow_harness(Pose2D(), 2, lost_time=0.5)
     nothing = Observation(np.zeros((0, 3)), 0.0, "bearings", ids=np.zeros(0, dtype=np.int64))
     harness.write("/perception/observation", nothing)
@@ -91,10 +91,22 @@ def test_follow_route_fails_when_lost_for_lost_time_and_stops_meanwhile():
     for step in range(8):
         harness.write("/perception/observation", Observation(nothing.bearings, step * 0.1, "bearings", ids=nothing.ids))
         statuses.append(harness.tick())
-        assert harness.read("/robot/command") == STOP
+        assert harness.read("/robot/command") == STOP  # no estimate yet: nothing to keep on with
         harness.clock.advance(0.1)
     assert statuses[:5] == [Status.RUNNING] * 5 and statuses[5] == Status.FAILURE
     assert "lost: 0 landmarks" in harness.behaviour.feedback_message
+
+
+def test_follow_route_coasts_over_a_short_gap():
+    harness = follow_harness(Pose2D(), 3, k=1, lost_time=0.5)
+    base = IdealBase(harness, Pose2D(PLACES[3].x - 0.4, 0.0, 0.0))
+    harness.tick()
+    moving = harness.read("/robot/command")
+    assert moving.v > 0
+    nothing = Observation(np.zeros((0, 3)), 1.0, "bearings", ids=np.zeros(0, dtype=np.int64))
+    harness.write("/perception/observation", nothing)
+    assert harness.tick() == Status.RUNNING and harness.read("/robot/command") == moving
+    assert base.pose.x < PLACES[3].x
 
 
 def test_follow_route_fails_when_stalled():
