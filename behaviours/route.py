@@ -40,7 +40,10 @@ How the paper is read here (where it is vague):
   of the route's end: the last viewframe is reached under ``goal_fraction`` (a quarter) of the
   threshold, or by the flip rule when the robot passes it.
 - **Flip rule.** The filtered direction to the target is compared with the previous one for the
-  same target; a change of more than ``flip_angle`` is a flip.
+  same target; a change of more than ``flip_angle`` is a flip. It counts only near the viewframe
+  (``delta_t`` under ``flip_near`` times the threshold): outdoors, with few near landmarks, the
+  direction is noisy metres away from a viewframe, and a flip there is noise, not a passed
+  viewframe.
 """
 
 from __future__ import annotations
@@ -383,6 +386,8 @@ class ViewframeSwitch(BearingsBehaviour):
                   doc="the route's last viewframe is reached under this fraction of the threshold"),
         InputPort("flip_angle", float, 90.0, unit="deg", minimum=1.0, maximum=180.0,
                   doc="a change of the direction to the target larger than this: it was passed"),
+        InputPort("flip_near", float, 4.0, minimum=1.0,
+                  doc="a flip counts only while delta_t is under this many thresholds (near the viewframe)"),
         TURN_RATE,
         LTMAP_IN, PROGRESS_IN, ODOMETRY,
         InputPort("estimate", RouteEstimate, Ref(ESTIMATE_KEY), doc="the latest estimate (FollowRoute)"),
@@ -438,7 +443,8 @@ class ViewframeSwitch(BearingsBehaviour):
         if estimate.delta_t < threshold:  # eq. 1 under the threshold: at the viewframe
             return "delta_t"
         blocked = self.now() - progress.switched_at < self.block_time
-        if blocked or self._heading is None or not math.isfinite(estimate.heading):
+        far = estimate.delta_t >= float(self.get_input("flip_near")) * threshold
+        if blocked or far or self._heading is None or not math.isfinite(estimate.heading):
             return None
         limit = math.radians(float(self.get_input("flip_angle")))
         return "flip" if heading_flipped(self._heading, estimate.heading, limit=limit) else None

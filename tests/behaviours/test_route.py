@@ -139,18 +139,27 @@ def test_switch_moves_on_when_delta_t_falls_under_the_threshold():
 def test_flip_rule_is_blocked_for_a_half_turn_after_a_switch():
     harness = switch_harness(RouteProgress(1, 2, 5, 0.0), turn_rate=45.0)  # 4 s to turn 180 deg
     assert harness.behaviour.block_time == pytest.approx(4.0)
-    far = TREE.threshold * 5
+    near = TREE.threshold * 2
     for t, heading in ((1.0, 0.1), (2.0, 3.0)):  # a flip at 2 s: blocked
         harness.clock.set(t)
-        harness.write("/map/route_estimate", estimate(2, t, far, heading))
+        harness.write("/map/route_estimate", estimate(2, t, near, heading))
         harness.tick()
     assert harness.read("/map/route_progress").target == 2
     for t, heading in ((4.5, 3.0), (5.0, 0.2)):  # after the block, a flip switches
         harness.clock.set(t)
-        harness.write("/map/route_estimate", estimate(2, t, far, heading))
+        harness.write("/map/route_estimate", estimate(2, t, near, heading))
         harness.tick()
     assert harness.read("/map/route_progress").target == 3
     assert harness.behaviour.report_sections()["ltmap"]["switches_by_flip"] == 1
+
+
+def test_a_flip_far_from_the_viewframe_is_noise():
+    harness = switch_harness(RouteProgress(1, 2, 5, 0.0), turn_rate=90.0)
+    for t, heading in ((5.0, 0.1), (5.5, 3.0)):
+        harness.clock.set(t)
+        harness.write("/map/route_estimate", estimate(2, t, TREE.threshold * 10, heading))
+        harness.tick()
+    assert harness.read("/map/route_progress").target == 2
 
 
 def test_the_goal_needs_a_tighter_delta_t_and_ends_the_route():
