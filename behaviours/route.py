@@ -228,8 +228,9 @@ class FollowRoute(BearingsBehaviour):
 
     RUNNING while it follows (it never ends by itself: :class:`ViewframeSwitch` ends the route);
     FAILURE when the trail is lost (fewer than ``min_matches`` landmarks match, or no usable
-    estimate, for ``lost_time``; until then it keeps the last command) or the base is stalled. Writes the velocity to ``command`` and
-    a :class:`RouteEstimate` per new observation to ``estimate``.
+    estimate, for ``lost_time``; until then it keeps the last command) or the base is stalled.
+    Writes the velocity to ``command`` and a :class:`RouteEstimate` per new observation to
+    ``estimate``.
     """
 
     PORTS = (
