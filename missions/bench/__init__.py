@@ -8,4 +8,5 @@ AREAS = {
     "tree": "missions.bench.tree",
     "sim": "missions.bench.sim",
     "perception": "missions.bench.perception",
+    "sweep": "missions.bench.sweep",
 }

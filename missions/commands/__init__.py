@@ -12,4 +12,5 @@ COMMANDS = (
     "missions.commands.bench",
     "missions.commands.sim",
     "missions.commands.calibrate",
+    "missions.commands.sweep",
 )
