@@ -94,24 +94,14 @@ def _run(args: argparse.Namespace) -> int:
         if args.mission or args.output:
             return fail("sweep", "--summary RESULTS_DIR takes no MISSION and no -o")
         return _show(args.summary, args)
-    if not args.mission or args.output is None:
-        return fail("sweep", "give MISSION and -o RESULTS_DIR (or --summary RESULTS_DIR)")
     try:
         episodes = _episodes(args)
-    except spec.SweepInputError as exc:
-        return fail("sweep", str(exc))
-    problem = _check_plot_options(args)
-    if problem:
-        return fail("sweep", problem)
-    try:
         with _executor(args) as executor:
             check_episodes(episodes, executor, timeout_s=args.timeout or 120.0, start_method=args.start_method)
             with _sigterm_as_interrupt():
                 run_sweep(episodes, executor=executor, results_dir=args.output, timeout_s=args.timeout,
                           resume=args.resume, progress=progress_stream(args.progress), start_method=args.start_method)
-    except spec.SweepInputError as exc:
-        return fail("sweep", str(exc))
-    except _NoCluster as exc:
+    except spec.SweepInputError as exc:  # bad options, a run command's diagnostic, no cluster
         return fail("sweep", str(exc))
     except SweepInterrupted as exc:
         _finish(args.output, args)
@@ -126,6 +116,14 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _episodes(args: argparse.Namespace) -> list[spec.Episode]:
+    """The grid the options describe; :class:`SweepInputError` for any invalid option."""
+    if not args.mission or args.output is None:
+        raise spec.SweepInputError("give MISSION and -o RESULTS_DIR (or --summary RESULTS_DIR)")
+    if args.output.exists() and not args.output.is_dir():
+        raise spec.SweepInputError(f"-o {args.output}: not a folder")
+    problem = _check_plot_options(args)
+    if problem:
+        raise spec.SweepInputError(problem)
     if args.workers is not None and args.workers < 1:
         raise spec.SweepInputError("--workers must be at least 1")
     for name, value in (("--timeout", args.timeout), ("--max-time", args.max_time)):
@@ -138,8 +136,8 @@ def _episodes(args: argparse.Namespace) -> list[spec.Episode]:
     return spec.grid(mission, worlds, seeds, sets, max_time_s=args.max_time)
 
 
-class _NoCluster(Exception):
-    pass
+class _NoCluster(spec.SweepInputError):
+    """--cluster cannot be used (no distributed package, or no scheduler there)."""
 
 
 @contextlib.contextmanager

@@ -91,29 +91,30 @@ def episode_processes(marker: str) -> list[int]:
     return found
 
 
-@pytest.mark.parametrize("start_method", ["fork", "spawn"])
-def test_killed_crashed_and_hung_episodes_are_failed_rows(trap, tmp_path, capsys, start_method):
+@pytest.mark.parametrize(("start_method", "seeds"), [("fork", [0, 1]), ("spawn", [0])])
+def test_killed_crashed_and_hung_episodes_are_failed_rows(trap, tmp_path, capsys, start_method, seeds):
     out = tmp_path / "out"
-    code = main(["sweep", str(trap), "--set", "action=none,kill,exit,hang", "--seeds", "0-1", "--timeout", "2",
-                 "--workers", "2", "--start-method", start_method, "-o", str(out)])
+    code = main(["sweep", str(trap), "--set", "action=none,kill,exit,hang", "--seeds", f"0-{len(seeds) - 1}",
+                 "--timeout", "1.5", "--workers", "2", "--start-method", start_method, "-o", str(out)])
     assert code == 0  # every episode has its row
     rows = {(r["inputs.action"], r["seed"]): r for r in rows_of(out)}
-    assert len(rows) == 8
-    for seed in (0, 1):
+    assert len(rows) == 4 * len(seeds)
+    for seed in seeds:
         assert rows["none", seed]["status"] == "SUCCESS"
         assert (rows["kill", seed]["status"], rows["kill", seed]["reason"]) == ("ERROR", "killed by SIGKILL")
         assert rows["kill", seed]["exit_code"] == -signal.SIGKILL
         assert rows["exit", seed]["status"] == "ERROR"
         assert rows["exit", seed]["reason"].startswith("exited with code 3 without a report")
         assert rows["hang", seed]["status"] == "ERROR"
-        assert rows["hang", seed]["reason"] == "timed out after 2 s wall time (episode killed)"
-        assert 2 <= rows["hang", seed]["elapsed_s"] < 5
+        assert rows["hang", seed]["reason"] == "timed out after 1.5 s wall time (episode killed)"
+        assert 1.5 <= rows["hang", seed]["elapsed_s"] < 5
     failed = [r for r in rows.values() if r["status"] == "ERROR"]
     assert all((out / "logs" / f"{r['id']}.log").is_file() for r in failed)
-    assert len(list((out / "reports").iterdir())) == 2  # only the episodes that reported
+    assert len(list((out / "reports").iterdir())) == len(seeds)  # only the episodes that reported
     summary = {line.split()[0]: line.split()[1:5] for line in capsys.readouterr().out.splitlines()[1:5]}
-    assert summary == {"exit": ["2", "0%", "0", "2"], "hang": ["2", "0%", "0", "2"], "kill": ["2", "0%", "0", "2"],
-                       "none": ["2", "100%", "0", "0"]}
+    n = str(len(seeds))
+    assert summary == {"exit": [n, "0%", "0", n], "hang": [n, "0%", "0", n], "kill": [n, "0%", "0", n],
+                       "none": [n, "100%", "0", "0"]}
     assert not episode_processes(str(trap))
 
 
