@@ -71,6 +71,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="each run's process: forked from a warm server per worker (default; saves the imports) "
                              "or a fresh interpreter")
     parser.add_argument("--resume", action="store_true", help="skip the runs RESULTS_DIR already has")
+    parser.add_argument("--retry-errors", action="store_true",
+                        help="with --resume: run the runs that crashed, hung or were killed again")
     parser.add_argument("--progress", action="store_true", help="progress on stderr even when it is not a terminal")
     parser.add_argument("-o", "--output", type=Path, metavar="RESULTS_DIR", help="folder for the results")
     parser.add_argument("--summary", type=Path, metavar="RESULTS_DIR", help="print the summary of earlier results")
@@ -100,7 +102,8 @@ def _run(args: argparse.Namespace) -> int:
             check_episodes(episodes, executor, timeout_s=args.timeout or 120.0, start_method=args.start_method)
             with _sigterm_as_interrupt():
                 run_sweep(episodes, executor=executor, results_dir=args.output, timeout_s=args.timeout,
-                          resume=args.resume, progress=progress_stream(args.progress), start_method=args.start_method)
+                          resume=args.resume, retry_errors=args.retry_errors, progress=progress_stream(args.progress),
+                          start_method=args.start_method)
     except spec.SweepInputError as exc:  # bad options, a run command's diagnostic, no cluster
         return fail("sweep", str(exc))
     except SweepInterrupted as exc:
@@ -124,6 +127,8 @@ def _episodes(args: argparse.Namespace) -> list[spec.Episode]:
     problem = _check_plot_options(args)
     if problem:
         raise spec.SweepInputError(problem)
+    if args.retry_errors and not args.resume:
+        raise spec.SweepInputError("--retry-errors goes with --resume")
     if args.workers is not None and args.workers < 1:
         raise spec.SweepInputError("--workers must be at least 1")
     for name, value in (("--timeout", args.timeout), ("--max-time", args.max_time)):

@@ -101,6 +101,7 @@ def run_sweep(
     timeout_s: float | None = None,
     on_row: Callable[[Row], None] | None = None,
     resume: bool = False,
+    retry_errors: bool = False,
     progress: TextIO | None = None,
     start_method: str = "fork",
 ) -> list[Row]:
@@ -112,7 +113,8 @@ def run_sweep(
     (``logs/<id>.log``) go; None keeps rows in memory only. ``timeout_s``: wall-clock limit per
     episode, after which it is killed and recorded as ERROR. ``on_row``: called in this process
     with each row as it is recorded. ``resume``: skip episodes the table already has (without it
-    a folder that has results is an error). ``progress``: a stream for the progress line.
+    a folder that has results is an error); ``retry_errors``: with it, run the ERROR rows again
+    (their new rows replace them). ``progress``: a stream for the progress line.
     ``start_method``: how each episode's process starts, ``fork`` (from a warm server per worker,
     the default) or ``spawn`` (a fresh interpreter); see :mod:`missions.sweep.worker`.
 
@@ -121,7 +123,8 @@ def run_sweep(
     """
     unique = {episode.id: episode for episode in episodes}
     with _Workspace(results_dir, resume) as space:
-        done = {i: row for i, row in space.existing.items() if i in unique}
+        done = {i: row for i, row in space.existing.items()
+                if i in unique and not (retry_errors and row.get("status") == "ERROR")}
         todo = [episode for i, episode in sorted(unique.items()) if i not in done]
         meter = Progress(len(unique), len(done), progress)
         stop = StopToken(str(space.stop_path), _dask_event_name(executor))

@@ -148,3 +148,8 @@ def test_ctrl_c_keeps_finished_rows_kills_running_episodes_and_resume_runs_the_r
     rows = rows_of(out)
     assert [r["inputs.action"] for r in rows] == ["hang", "none"] and rows[1] == first
     assert rows[0]["reason"] == "timed out after 1 s wall time (episode killed)"
+    assert main(["sweep", str(trap), "--set", "action=none,hang", "--timeout", "0.5", "--workers", "1",
+                 "--resume", "--retry-errors", "-o", str(out)]) == 0
+    rows = rows_of(out)
+    assert [r["inputs.action"] for r in rows] == ["hang", "none"] and rows[1] == first
+    assert rows[0]["reason"] == "timed out after 0.5 s wall time (episode killed)"  # run again, its row replaced
