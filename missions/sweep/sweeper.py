@@ -168,7 +168,10 @@ def check_episodes(episodes: Sequence[Episode], executor: Executor, *, timeout_s
     probes = list(dict.fromkeys(checks.values()))
     futures = [executor.submit(run_episode, probe, timeout_s, None, start_method) for probe in probes]
     for probe, future in zip(probes, futures, strict=True):
-        result = future.result()
+        try:
+            result = future.result()
+        except Exception as exc:  # noqa: BLE001 - e.g. Dask workers without this version of bearings
+            raise SweepInputError(f"the workers could not run the check ({type(exc).__name__}: {exc})") from None
         if result.error == "invalid":
             problems = [line.strip() for line in result.output.splitlines()
                         if line.strip() and not re.fullmatch(r"\d+ problems? found", line.strip())]
