@@ -29,7 +29,7 @@ from typing import Any, TextIO
 from maps.store import write_text_atomic
 from missions.sweep.episode import Episode, SweepInputError
 from missions.sweep.table import LOGS, REPORTS, TABLE, Journal, latest_by_id, make_row, read_rows, write_sorted
-from missions.sweep.worker import EpisodeResult, StopToken, run_episode
+from missions.sweep.worker import START_METHODS, EpisodeResult, StopToken, run_episode
 
 Row = dict[str, Any]
 
@@ -121,6 +121,8 @@ def run_sweep(
     Raises :class:`SweepInterrupted` on Ctrl-C (finished rows kept, running episodes killed) and
     :class:`SweepError` when the executor lost episodes; both carry the recorded rows.
     """
+    if start_method not in START_METHODS:
+        raise ValueError(f"start_method must be one of {', '.join(START_METHODS)}, not {start_method!r}")
     unique = {episode.id: episode for episode in episodes}
     with _Workspace(results_dir, resume) as space:
         done = {i: row for i, row in space.existing.items()

@@ -100,13 +100,18 @@ episode is its own process; ``fork`` saves the ~0.3 s of imports per episode."""
 
 def run_episode(episode: Episode, timeout_s: float | None = None, stop: StopToken | None = None,
                 start_method: str = "fork") -> EpisodeResult:
-    """Run one episode in its own process; never raises for anything the episode does."""
+    """Run one episode in its own process; never raises for anything the episode does. The time
+    limit and ``elapsed_s`` count from the start of the episode's process (a worker's first
+    episode does not pay for starting the worker's episode server)."""
+    if start_method not in START_METHODS:
+        raise ValueError(f"start_method must be one of {', '.join(START_METHODS)}, not {start_method!r}")
+    server = _Server.get() if start_method == "fork" else None
     started = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="bearings-episode-") as folder:
         report = Path(folder) / "report.json"
         log = Path(folder) / "output.txt"
         argv = episode.run_arguments(report)
-        ended = _run_forked(argv, log, started, timeout_s, stop) if start_method == "fork" else None
+        ended = _run_forked(server, argv, log, started, timeout_s, stop) if server is not None else None
         code, outcome = ended or _run_spawned(argv, log, started, timeout_s, stop)
         elapsed = time.monotonic() - started
         text = log.read_text(encoding="utf-8", errors="replace") if log.is_file() else ""
@@ -126,11 +131,11 @@ def _run_spawned(argv: list[str], log: Path, started: float, timeout_s: float | 
     return process.returncode, outcome
 
 
-def _run_forked(argv: list[str], log: Path, started: float, timeout_s: float | None,
+def _run_forked(server: _Server | None, argv: list[str], log: Path, started: float, timeout_s: float | None,
                 stop: StopToken | None) -> tuple[int | None, str | None] | None:
-    """The episode forked from this thread's warm server; None if there is no server to use."""
+    """The episode forked from this thread's warm server (started again once if it dies under
+    the episode); None if there is no server to use."""
     for attempt in (1, 2):
-        server = _Server.get()
         if server is None:
             return None
         try:
@@ -139,6 +144,7 @@ def _run_forked(argv: list[str], log: Path, started: float, timeout_s: float | N
             _Server.drop()
             if attempt == 2:
                 return None, "lost"
+            server = _Server.get()
     return None
 
 
