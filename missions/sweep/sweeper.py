@@ -133,16 +133,21 @@ def run_sweep(
         stop.clear()
         owned = executor is None
         executor = executor or local_executor()
+        finished = False
         try:
             task = functools.partial(run_episode, timeout_s=timeout_s, stop=stop, start_method=start_method)
             new_rows, lost = _execute(todo, executor, task, space, on_row, meter, stop)
+            finished = True
         except KeyboardInterrupt:
             rows = sorted([*done.values(), *space.recorded], key=lambda r: r["id"])
             raise SweepInterrupted(rows, len(unique)) from None
         finally:
-            if owned:
+            if owned:  # waits for the running tasks, which see the stop token and kill their episodes
                 executor.shutdown(wait=True, cancel_futures=True)
-            stop.clear()
+            if finished or owned:
+                stop.clear()
+            else:  # tasks of a caller's executor may still be running (a Dask task cannot be
+                space.keep_scratch = True  # interrupted, only told): the token stays set for them
             meter.finish()
     rows = sorted([*done.values(), *new_rows], key=lambda r: r["id"])
     if lost:
@@ -242,6 +247,7 @@ class _Workspace:
         self.journal: Journal | None = None
         self._lock_fd = -1
         self._scratch: str | None = None
+        self.keep_scratch = False
 
     def __enter__(self) -> _Workspace:
         if self.folder is None:
@@ -260,7 +266,7 @@ class _Workspace:
         return self
 
     def __exit__(self, *_exc: object) -> None:
-        if self._scratch is not None:
+        if self._scratch is not None and not self.keep_scratch:
             shutil.rmtree(self._scratch, ignore_errors=True)
         if self.journal is not None and self.folder is not None:
             self.journal.close()

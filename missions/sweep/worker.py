@@ -105,6 +105,8 @@ def run_episode(episode: Episode, timeout_s: float | None = None, stop: StopToke
     episode does not pay for starting the worker's episode server)."""
     if start_method not in START_METHODS:
         raise ValueError(f"start_method must be one of {', '.join(START_METHODS)}, not {start_method!r}")
+    if stop is not None and stop.is_set():  # queued before the sweep was stopped: do not start it
+        return EpisodeResult(episode.id, None, None, "interrupted", "the sweep was stopped", 0.0)
     server = _Server.get() if start_method == "fork" else None
     started = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="bearings-episode-") as folder:

@@ -46,6 +46,8 @@ class Trap(BearingsBehaviour):
         elif action == "exit":
             os._exit(3)
         elif action == "hang":
+            with open(os.path.join(os.path.dirname(__file__), f"hanging-{os.getpid()}"), "w"):
+                pass  # the test checks that this process is gone after the sweep
             while True:
                 time.sleep(3600)
         return Status.SUCCESS
@@ -78,17 +80,33 @@ def rows_of(folder: Path) -> list[dict]:
     return [json.loads(line) for line in (folder / "results.jsonl").read_text().splitlines()]
 
 
-def episode_processes(marker: str) -> list[int]:
-    """Processes whose command line or arguments mention ``marker`` (a test's own folder)."""
-    found = []
+def hanging_episodes(folder: Path) -> list[int]:
+    """Ids of the episode processes that started to hang (the plugin leaves a file each)."""
+    return [int(p.name.split("-")[1]) for p in folder.glob("hanging-*")]
+
+
+def descendants(root: int) -> set[int]:
+    """Every live process under ``root`` (its pool workers, their episode servers, episodes)."""
+    parents = {}
     for entry in Path("/proc").iterdir():
-        if entry.name.isdigit() and int(entry.name) != os.getpid():
+        if entry.name.isdigit():
             try:
-                if marker.encode() in (entry / "cmdline").read_bytes():
-                    found.append(int(entry.name))
+                parents[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
             except OSError:
                 continue
+    found, frontier = set(), {root}
+    while frontier:
+        frontier = {pid for pid, parent in parents.items() if parent in frontier} - found
+        found |= frontier
     return found
+
+
+def alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
 
 
 @pytest.mark.parametrize(("start_method", "seeds"), [("fork", [0, 1]), ("spawn", [0])])
@@ -115,7 +133,8 @@ def test_killed_crashed_and_hung_episodes_are_failed_rows(trap, tmp_path, capsys
     n = str(len(seeds))
     assert summary == {"exit": [n, "0%", "0", n], "hang": [n, "0%", "0", n], "kill": [n, "0%", "0", n],
                        "none": [n, "100%", "0", "0"]}
-    assert not episode_processes(str(trap))
+    hung = hanging_episodes(trap.parent)
+    assert len(hung) == len(seeds) and not any(alive(pid) for pid in hung)
 
 
 def test_ctrl_c_keeps_finished_rows_kills_running_episodes_and_resume_runs_the_rest(trap, tmp_path):
@@ -130,8 +149,13 @@ def test_ctrl_c_keeps_finished_rows_kills_running_episodes_and_resume_runs_the_r
         while not (out / "results.jsonl").is_file() or not (out / "results.jsonl").read_text().strip():
             assert time.monotonic() < deadline and sweep.poll() is None, sweep.communicate()
             time.sleep(0.05)
-        time.sleep(0.3)  # the hanging episode is running
-        assert episode_processes(str(trap))
+        while not hanging_episodes(trap.parent):
+            assert time.monotonic() < deadline and sweep.poll() is None, sweep.communicate()
+            time.sleep(0.05)
+        hung = hanging_episodes(trap.parent)
+        assert all(alive(pid) for pid in hung)
+        started = descendants(sweep.pid)
+        assert set(hung) <= started and len(started) >= 3  # workers, their episode servers, the episode
         os.killpg(sweep.pid, signal.SIGINT)  # Ctrl-C reaches the whole group
         _, err = sweep.communicate(timeout=20)
     finally:
@@ -141,7 +165,10 @@ def test_ctrl_c_keeps_finished_rows_kills_running_episodes_and_resume_runs_the_r
     assert sweep.returncode == 1
     assert "interrupted; 1 of 2 runs recorded" in err and "Traceback" not in err
     assert [r["inputs.action"] for r in rows_of(out)] == ["none"]
-    assert not episode_processes(str(trap))  # the hanging episode was killed, no worker left behind
+    deadline = time.monotonic() + 5
+    while any(alive(pid) for pid in started) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not [pid for pid in started if alive(pid)]  # the hanging episode was killed, nothing left behind
     first = rows_of(out)[0]
     assert main(["sweep", str(trap), "--set", "action=none,hang", "--timeout", "1", "--workers", "1",
                  "--resume", "-o", str(out)]) == 0
