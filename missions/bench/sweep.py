@@ -28,9 +28,11 @@ import statistics
 import subprocess
 import sys
 import time
+from concurrent.futures import wait
 
 from missions.sweep import Episode, local_executor, run_sweep
 from missions.sweep.sweeper import default_workers
+from missions.sweep.worker import run_episode
 
 MISSION = "square"
 INPUTS = {"side": 0.1}
@@ -51,12 +53,15 @@ def _timed(executor, count: int, first_seed: int, start_method: str) -> tuple[fl
     return count / elapsed, rows
 
 
-def _throughput(workers: int, per_worker: int, repeats: int) -> tuple[float, float, float, list[dict]]:
+def _throughput(workers: int, per_worker: int, repeats: int,
+                spawned: int) -> tuple[float, float, float, list[dict], list[dict]]:
     """Best-of-``repeats`` episodes per second on 1 and on N workers, and the machine's own scaling
-    (:func:`_spin`), all interleaved so that load from other jobs on a shared machine hits each alike."""
+    (:func:`_spin`), all interleaved so that load from other jobs on a shared machine hits each
+    alike; then ``spawned`` episodes started with ``spawn`` on the 1-worker pool."""
     with local_executor(1) as one, local_executor(workers) as many:
-        for executor, count in ((one, 1), (many, workers)):  # start the workers and their episode servers
-            _timed(executor, count, 10_000 + count, "fork")
+        warm_up = [executor.submit(run_episode, episode)  # start the workers and their episode servers, together
+                   for executor, count in ((one, 1), (many, workers)) for episode in _episodes(count, 10_000 + count)]
+        wait(warm_up)
         best_1, best_n, spin_1, spin_n, rows_1 = 0.0, 0.0, float("inf"), float("inf"), []
         for repeat in range(repeats):
             spin_1 = min(spin_1, _spin(1))
@@ -65,7 +70,8 @@ def _throughput(workers: int, per_worker: int, repeats: int) -> tuple[float, flo
                 best_1, rows_1 = rate, rows
             spin_n = min(spin_n, _spin(workers))
             best_n = max(best_n, _timed(many, per_worker * workers, 1000 * repeat + 500, "fork")[0])
-    return best_1, best_n, spin_1 / spin_n, rows_1
+        spawn_rows = _timed(one, spawned, 20_000, "spawn")[1]
+    return best_1, best_n, spin_1 / spin_n, rows_1, spawn_rows
 
 
 def _process_time(code: str, repeats: int) -> float:
@@ -90,10 +96,8 @@ def _mean(rows: list[dict], key: str) -> float:
 
 def run(quick: bool = False) -> dict:
     workers = default_workers()
-    per_worker = 4 if quick else 30
-    rate_1, rate_n, machine, rows_1 = _throughput(workers, per_worker, 1 if quick else 5)
-    with local_executor(1) as executor:
-        _, spawned = _timed(executor, 1 if quick else 8, 20_000, "spawn")
+    per_worker = 3 if quick else 30
+    rate_1, rate_n, machine, rows_1, spawned = _throughput(workers, per_worker, 1 if quick else 5, 1 if quick else 8)
     elapsed, wall = _mean(rows_1, "elapsed_s"), _mean(rows_1, "wall_time_s")
     spawn_elapsed, spawn_wall = _mean(spawned, "elapsed_s"), _mean(spawned, "wall_time_s")
     repeats = 1 if quick else 5

@@ -99,7 +99,7 @@ def _run(args: argparse.Namespace) -> int:
     try:
         episodes = _episodes(args)
         with _executor(args) as executor:
-            check_episodes(episodes, executor, timeout_s=args.timeout or 120.0, start_method=args.start_method)
+            check_episodes(episodes, executor, start_method=args.start_method)
             with _sigterm_as_interrupt():
                 run_sweep(episodes, executor=executor, results_dir=args.output, timeout_s=args.timeout,
                           resume=args.resume, retry_errors=args.retry_errors, progress=progress_stream(args.progress),

@@ -23,6 +23,9 @@ import yaml
 MAX_EPISODES = 100_000
 """The largest grid a sweep accepts (a typo like ``--seeds 0-9999999`` is an input error)."""
 
+MAX_SEED = 2**32 - 1
+"""The largest seed ``bearings run --seed`` takes (checked here for every seed, not only the first)."""
+
 _UNSAFE = re.compile(r"[^A-Za-z0-9.+=-]+")
 
 
@@ -129,6 +132,8 @@ def parse_seeds(spec: str) -> list[int]:
         last = int(match.group(2)) if match.group(2) is not None else first
         if last < first:
             raise SweepInputError(f"--seeds {spec}: the range {text} is empty (write it as {last}-{first})")
+        if last > MAX_SEED:
+            raise SweepInputError(f"--seeds {spec}: seeds go from 0 to {MAX_SEED}")
         if last - first >= MAX_EPISODES:
             raise SweepInputError(f"--seeds {spec}: more than {MAX_EPISODES} seeds")
         seeds.update(range(first, last + 1))

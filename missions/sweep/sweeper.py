@@ -166,7 +166,9 @@ def check_episodes(episodes: Sequence[Episode], executor: Executor, *, timeout_s
     """Raise :class:`SweepInputError` (one line) if the run command rejects any mission, world or
     combination of inputs of ``episodes`` (its exit code 2). Each distinct mission x world and
     mission x inputs is checked once, by the run command itself on the executor's workers (so paths
-    are checked where the episodes will run), with a time limit that lets nothing tick."""
+    are checked where the episodes will run), with a time limit that lets nothing tick.
+    ``timeout_s`` bounds each check (wall time; setting up is all it does, whatever the sweep's
+    own per-run limit)."""
     checks: dict[tuple, Episode] = {}
     for e in episodes:
         probe = Episode(e.mission, e.world, e.seed, e.inputs, CHECK_TIME_S)
@@ -262,6 +264,8 @@ class _Workspace:
             self._unlock()
             raise SweepInputError(f"{self.folder} already holds {len(self.existing)} results: add --resume to "
                                   "continue that sweep, or choose another folder")
+        for sub in (REPORTS, LOGS):
+            (self.folder / sub).mkdir(exist_ok=True)
         self.journal = Journal(self.folder / TABLE)
         return self
 

@@ -340,7 +340,16 @@ def _result(episode: Episode, code: int | None, outcome: str | None, report_text
         return make("invalid", f"invalid input: {_first_line(output)}")
     if code in (0, 1) and report_text is not None:
         return make(None, "", report_text)
+    if code is not None and code > 128 and report_text is not None:  # `bearings run` ended by a signal from
+        return make("killed", f"{_report_reason(report_text)} (exit {code})")  # outside (130 SIGINT, 143 SIGTERM)
     return make("crash", f"exited with code {code} without a report: {_last_line(output)}")
+
+
+def _report_reason(text: str) -> str:
+    try:
+        return str(json.loads(text).get("reason", "no reason in the report"))
+    except (ValueError, AttributeError):
+        return "an unreadable report"
 
 
 def _signal_name(number: int) -> str:
