@@ -35,6 +35,12 @@ from missions.sweep.child import die_with_parent
 PRELOAD = ("missions.cli", "missions.commands.run", "missions.runner", "drivers.sim.simulation", "numpy.random")
 """Modules ``bearings run`` imports; a missing one is skipped (the child imports what it needs)."""
 
+WARM_UP = ("run", "square", "--max-time", "1e-9", "--quiet")
+"""A run that loads a shipped mission and sets it up in the empty world, then stops before its
+first tick: it imports what loading and running import lazily (the built-in behaviours, say).
+Nothing it leaves behind changes an episode: each one builds its own registry, tree and world
+(the tests compare forked and freshly spawned episodes). If it fails, the server goes on without it."""
+
 
 class _Lines:
     """Whole JSON lines from a raw file descriptor, usable with select()."""
@@ -67,6 +73,10 @@ def preload() -> None:
             module = importlib.import_module(name)
             if name == "missions.cli":
                 module.build_parser()  # imports every command module
+    with contextlib.suppress(Exception, SystemExit):
+        from missions.cli import main as cli_main
+
+        cli_main(list(WARM_UP))  # prints go to stderr (see main)
     gc.collect()
     gc.freeze()  # children's collections leave the preloaded objects alone: fewer copy-on-write pages
 

@@ -218,7 +218,7 @@ def test_plot_without_matplotlib_says_how_to_install(tmp_path, capsys, monkeypat
 
 
 def test_api_runs_without_a_results_folder_and_forked_or_spawned_episodes_agree():
-    episodes = grid("square", ["empty"], [0, 1], {"side": [0.1]}, max_time_s=30)
+    episodes = grid("square", ["lab"], [0, 1], {"side": [0.1]}, max_time_s=30)
     seen = []
     forked = run_sweep(episodes, on_row=seen.append)
     assert [r["seed"] for r in forked] == [0, 1] and sorted(r["id"] for r in seen) == [r["id"] for r in forked]
