@@ -14,4 +14,5 @@ COMMANDS = (
     "missions.commands.calibrate",
     "missions.commands.doctor",
     "missions.commands.map",
+    "missions.commands.sweep",
 )
