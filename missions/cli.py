@@ -1,4 +1,4 @@
-"""The ``bearings`` command line: run, validate, show, schema, bench, sim, calibrate."""
+"""The ``bearings`` command line: one sub-command per module of :mod:`missions.commands`."""
 
 from __future__ import annotations
 
