@@ -4,42 +4,56 @@ Everything is in the odometry frame (REP-103: x, y on the floor, z up). The map 
 every update returns a new :class:`ExplorationMap`, so a reader on the blackboard never sees a
 half-integrated observation. Its parts:
 
-- ``cells``: an occupancy-style grid of :class:`Cell` (unknown / explored free / obstacle) that
-  grows in chunks when the robot nears its edge.
+- ``evidence``/``cells``: an occupancy grid (log-odds that a cell is occupied) and the
+  :class:`Cell` grid it gives (unknown / explored free / obstacle); it grows in chunks when the
+  robot nears its edge.
 - ``points``: the 3-D points the stereo pair detected (their floor projections are ``points[:,
   :2]``), one per voxel (``IntegrationParams.voxel``): a feature seen again from the same place is
   the same point, so memory grows with the explored volume, not with time.
 - ``edges``/``interest``: pairs of points that were neighbours in an image (left pixels at most
-  ``max_edge_px`` apart) and their :class:`Interest` state (eq. 2).
+  ``max_edge_px`` apart) with a depth jump when seen (r < 0.95), and their :class:`Interest`
+  state (eq. 2). Neighbours on one surface (r >= 0.95 at once: nine edges in ten) are not
+  stored: they would be *never* from birth, and the pair seen again from elsewhere is judged
+  afresh.
 
 The paper is vague in places; the choices made here:
 
-- **What counts as explored** (the observation model of :func:`integrate_stereo`): from the
-  camera's floor position, a ray is cast in plan towards the floor projection of every point that
-  is on the floor or on an obstacle (below ``obstacle_height``); cells on it are explored free
-  from where the floor enters the image (the footprint's near edge, ``eye_z / tan(depression)``
-  along the optical axis, over ``cos`` of the ray's azimuth: the image's bottom row is a line on
-  the floor, perpendicular to the axis, for a camera without roll) to the point, the far edge of
-  the footprint, or ``explore_range``, whichever is first. The image column that shows the point
-  shows the floor in front of it; an occluder in between would have given a nearer point (in
-  that case its obstacle cell wins: obstacle cells are never cleared by rays). Points higher than
+- **What counts as explored** (the observation model of :func:`integrate_stereo`): the points
+  on the floor or on obstacles (below ``obstacle_height``) make a virtual range scan: per
+  ``scan_bin`` of azimuth across the camera's horizontal field, the plan range of the nearest
+  obstacle point, else of the farthest floor point. The floor from where it enters the image (the
+  footprint's near edge, ``eye_z / tan(depression)`` along the optical axis, over ``cos`` of the
+  azimuth: the image's bottom row is a line on the floor across the axis for a camera without
+  roll) out to that range, the footprint's far edge or ``explore_range``, whichever is first, was
+  seen free: the image column of a point shows the floor in front of it, and an occluder in
+  between would have given a nearer point. Bins without points stay unknown. Points higher than
   ``obstacle_height`` (the ceiling, tops of tall walls) say nothing about the floor below them.
-  ``explore_range`` is deliberately shorter than ``max_range`` (stereo depth error grows as Z^2):
-  the points beyond it are detected but their floor is not yet explored, which is what gives the
-  attractive power (eq. 1) something to aim at. The robot's own disc is marked by
-  :func:`mark_traversed` (where it is, the floor is free): call it before the first goal selection.
+  (Rays to single points instead leave one-cell combs, all border.) ``explore_range`` is
+  deliberately shorter than ``max_range`` (stereo depth error grows as Z^2): the points beyond it
+  are detected but their floor is not yet explored, which is what gives the attractive power
+  (eq. 1) something to aim at.
 - **Obstacles** are points between ``floor_tolerance`` and ``obstacle_height`` within
-  ``explore_range``. They are sticky (no ray clears them; only :func:`mark_traversed` does,
-  because the robot stood there): a false obstacle costs a detour, a cleared true one a collision.
+  ``explore_range``. Evidence is accumulated as log-odds (:class:`EvidenceParams`): a hit adds,
+  a free sighting subtracts, so the speckle of a stereo matcher and obstacles smeared by odometry
+  drift clear again when the floor is seen there later (sticky obstacles closed the door behind
+  the robot in a simulated run, leaving it "done" in one room).
+- **The blind zone**: a camera 1.1 m up never sees the floor next to the robot (even tilted to
+  the PTU-D46's -47 degrees, the footprint starts ~0.4 m in front of the lens). Where the robot
+  stands the floor is free: :func:`mark_traversed` marks its disc, every tick; at the start, call
+  it with a larger radius (the free floor assumed around the start pose, ~0.6 m) and look around
+  (:func:`maps.exploration_gaze.survey`) so that the first footprints join the robot's disc.
 - **Borders** are explored free cells with an unknown 4-neighbour, grouped 8-connected; groups
   smaller than ``min_cells`` are dropped (explore_lite's ``min_frontier_size``).
 - **Travel cost G(v_S, P_b)** is the 8-connected grid shortest path (Dijkstra from
   ``scipy.sparse.csgraph``, step costs ``res`` and ``res * sqrt 2``) through *known* free space
   whose clearance to the nearest obstacle cell exceeds the robot radius (clearance from
   ``scipy.ndimage.distance_transform_edt``). Unknown cells are not traversed but do not inflate:
-  a border next to the unknown must be reachable. A robot standing on a cell that is not
-  traversable (a fresh obstacle within its radius) starts from the nearest traversable cell
-  within one radius, the snap added to every cost.
+  a border next to the unknown must be reachable. The robot's trail (``visited``) is always
+  traversable: it fitted there, and new obstacle evidence (a squeeze narrowed by stereo noise)
+  must not lock it in a pocket of the map, which would read as "no border reachable", i.e.
+  done. A robot standing on a cell that is not traversable starts from the nearest traversable
+  cell within one radius, the snap added to every cost. Optionally, steps near obstacles cost more
+  (``margin``, ``penalty``), so that paths keep off walls where there is room.
 - **Interest edges (eq. 2)**: ``r = p_c / p_f`` with ``p_c``, ``p_f`` the 3-D distances from the
   camera to the edge's closer and farther point, and ``phi`` the angle between the robot's heading
   (its direction of travel) and the direction, in plan, from the camera to the closer point. An
@@ -69,7 +83,7 @@ from scipy.spatial import cKDTree
 from perception.camera import PinholeCamera, StereoRig
 from perception.geometry import Pose2D, wrap_angles
 
-_SHIFT = 4  # sub-cell precision (bits) of the rays drawn by cv2.polylines
+_SHIFT = 4  # sub-cell precision (bits) of the scan's wedges drawn by cv2.fillConvexPoly
 _CROSS = ndimage.generate_binary_structure(2, 1)
 _SQUARE = ndimage.generate_binary_structure(2, 2)
 
@@ -159,26 +173,46 @@ def _readonly(a: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True, slots=True)
+class EvidenceParams:
+    """Log-odds steps of the occupancy evidence (Thrun's occupancy grid): a cell is an obstacle
+    while its evidence is positive, explored free while negative, unknown at 0 (never seen)."""
+
+    hit: float = 0.85  # an obstacle point in the cell (once per observation)
+    miss: float = 0.4  # the cell seen as free floor
+    low: float = -2.0  # clamps: a wall seen 5 times outlives ~10 free sightings (drift), ...
+    high: float = 3.5  # ...a single false hit is gone after 3
+
+
+@dataclass(frozen=True, slots=True)
 class ExplorationMap:
     """The exploration map (see the module docstring); arrays are read-only.
 
-    ``cells``: (rows, cols) uint8 :class:`Cell`; ``points``: (N, 3) float, odometry frame;
-    ``edges``: (M, 2) int64 indices into ``points`` (smaller first); ``interest``: (M,) uint8
-    :class:`Interest`. Points and edges are only ever appended, so their indices are stable.
+    ``evidence``: (rows, cols) float32 log-odds that a cell is occupied (0: never seen);
+    ``cells``: the :class:`Cell` grid derived from it (uint8); ``points``: (N, 3) float,
+    odometry frame; ``edges``: (M, 2) int64 indices into ``points`` (smaller first);
+    ``interest``: (M,) uint8 :class:`Interest`; ``visited``: (rows, cols) bool, the cells the
+    robot's centre has been on (:func:`mark_traversed`). Points and edges are only ever appended,
+    so their indices are stable.
     """
 
     frame: GridFrame
-    cells: np.ndarray
+    evidence: np.ndarray
     points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     interest: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.uint8))
+    visited: np.ndarray | None = None
+    cells: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        if self.cells.shape != self.frame.shape:
-            raise ValueError(f"cells {self.cells.shape} do not match the frame {self.frame.shape}")
+        if self.evidence.shape != self.frame.shape:
+            raise ValueError(f"evidence {self.evidence.shape} does not match the frame {self.frame.shape}")
         if len(self.edges) != len(self.interest):
             raise ValueError("every edge needs an interest state")
-        for name in ("cells", "points", "edges", "interest"):
+        if self.visited is None:
+            object.__setattr__(self, "visited", np.zeros(self.frame.shape, dtype=bool))
+        cells = np.where(self.evidence > 0, Cell.OBSTACLE, np.where(self.evidence < 0, Cell.FREE, Cell.UNKNOWN))
+        object.__setattr__(self, "cells", cells.astype(np.uint8))
+        for name in ("evidence", "visited", "cells", "points", "edges", "interest"):
             object.__setattr__(self, name, _readonly(getattr(self, name)))
 
     @classmethod
@@ -188,7 +222,13 @@ class ExplorationMap:
         """An all-unknown square map of side ``2 * half_size`` m around ``centre``."""
         n = int(math.ceil(2.0 * half_size / resolution))
         frame = GridFrame(centre[0] - half_size, centre[1] - half_size, resolution, n, n)
-        return cls(frame, np.zeros(frame.shape, dtype=np.uint8))
+        return cls(frame, np.zeros(frame.shape, dtype=np.float32))
+
+    @classmethod
+    def from_cells(cls, frame: GridFrame, cells: np.ndarray, **arrays: np.ndarray) -> ExplorationMap:
+        """A map with the given :class:`Cell` grid (evidence -1 free, +1 obstacle), e.g. for tests."""
+        evidence = np.select([cells == Cell.FREE, cells == Cell.OBSTACLE], [-1.0, 1.0], 0.0).astype(np.float32)
+        return cls(frame, evidence, **arrays)
 
     def cell_state(self, xy: np.ndarray) -> np.ndarray:
         """The :class:`Cell` at each (x, y) (UNKNOWN outside the grid)."""
@@ -204,32 +244,49 @@ class ExplorationMap:
         return float(np.count_nonzero(self.cells == Cell.FREE)) * self.frame.resolution**2
 
     def _replace(self, **changes: np.ndarray | GridFrame) -> ExplorationMap:
-        values = {name: getattr(self, name) for name in ("frame", "cells", "points", "edges", "interest")}
+        names = ("frame", "evidence", "points", "edges", "interest", "visited")
+        values = {name: getattr(self, name) for name in names}
         values.update(changes)
         return ExplorationMap(**values)  # type: ignore[arg-type]
 
 
-def _covering(m: ExplorationMap, lo: np.ndarray, hi: np.ndarray, chunk_m: float) -> tuple[GridFrame, np.ndarray]:
-    """The frame and a writable copy of the cells, grown to cover ``lo``..``hi`` (x, y)."""
+def _covering(
+    m: ExplorationMap, lo: np.ndarray, hi: np.ndarray, chunk_m: float
+) -> tuple[GridFrame, np.ndarray, np.ndarray]:
+    """The frame and writable copies of the evidence and visited grids, grown to cover ``lo``..``hi``."""
     chunk = max(1, int(round(chunk_m / m.frame.resolution)))
     frame, down, left = m.frame.grown((float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1])), chunk)
-    cells = np.zeros(frame.shape, dtype=np.uint8)
-    cells[down : down + m.frame.rows, left : left + m.frame.cols] = m.cells
-    return frame, cells
+    old = (slice(down, down + m.frame.rows), slice(left, left + m.frame.cols))
+    evidence = np.zeros(frame.shape, dtype=np.float32)
+    evidence[old] = m.evidence
+    visited = np.zeros(frame.shape, dtype=bool)
+    visited[old] = m.visited
+    return frame, evidence, visited
 
 
-def mark_traversed(m: ExplorationMap, pose: Pose2D, radius: float, chunk_m: float = 4.0) -> ExplorationMap:
-    """The map with the robot's disc at ``pose`` explored free (it stands there), obstacles included."""
-    centre = np.array([pose.x, pose.y])
-    margin = radius + m.frame.resolution  # keeps the disc off the grid's edge (beyond it: unknown)
-    frame, cells = _covering(m, centre - margin, centre + margin, chunk_m)
+def _disc(frame: GridFrame, centre: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns of the cells whose centres lie within ``radius`` of ``centre``."""
     r0, c0 = (int(v[0]) for v in frame.cell_of(centre - radius))
     r1, c1 = (int(v[0]) for v in frame.cell_of(centre + radius))
-    rows, cols = np.mgrid[r0 : r1 + 1, c0 : c1 + 1]
-    xy = frame.centre_of(rows.ravel(), cols.ravel())
-    inside = np.hypot(xy[:, 0] - pose.x, xy[:, 1] - pose.y) <= radius
-    cells[rows.ravel()[inside], cols.ravel()[inside]] = Cell.FREE
-    return m._replace(frame=frame, cells=cells)
+    rows, cols = (a.ravel() for a in np.mgrid[r0 : r1 + 1, c0 : c1 + 1])
+    xy = frame.centre_of(rows, cols)
+    inside = np.hypot(xy[:, 0] - centre[0], xy[:, 1] - centre[1]) <= radius
+    return rows[inside], cols[inside]
+
+
+def mark_traversed(
+    m: ExplorationMap, pose: Pose2D, radius: float, chunk_m: float = 4.0, free: float = EvidenceParams().low
+) -> ExplorationMap:
+    """The map with the robot at ``pose``: its disc explored free at evidence ``free`` (it stands
+    there), and the cells within one cell of its centre ``visited`` (call it every tick: the trail
+    stays traversable whatever is seen later, so the robot can always go back the way it came)."""
+    centre = np.array([pose.x, pose.y])
+    margin = radius + 2 * m.frame.resolution  # keeps the disc off the grid's edge (beyond it: unknown)
+    frame, evidence, visited = _covering(m, centre - margin, centre + margin, chunk_m)
+    disc = _disc(frame, centre, radius)
+    evidence[disc] = np.minimum(evidence[disc], free)
+    visited[_disc(frame, centre, frame.resolution)] = True
+    return m._replace(frame=frame, evidence=evidence, visited=visited)
 
 
 # --------------------------------------------------------------------------------------------
@@ -409,13 +466,14 @@ def image_edges(uv: np.ndarray, max_px: float) -> np.ndarray:
 class IntegrationParams:
     """How a stereo observation becomes map (see the module docstring for the model)."""
 
-    explore_range: float = 3.0  # m (plan): floor is explored along rays up to here; obstacles marked up to here
+    explore_range: float = 3.0  # m (plan): floor is explored, obstacles marked, up to here
     max_range: float = 8.0  # m (plan): farther points are dropped (depth error grows as Z^2)
     floor_tolerance: float = 0.08  # m: points lower are on the floor
     obstacle_height: float = 1.3  # m: points up to this height (and above the floor) are obstacles to the robot
     voxel: float = 0.1  # m: one stored point per voxel
-    max_edge_px: float = 12.0  # image neighbours: pixels at most this far apart
+    max_edge_px: float = 12.0  # image neighbours: pixels this close (~1.5 x the step of dense points; ~40 sparse)
     scan_bin: float = math.radians(1.0)  # azimuth bins of the virtual range scan
+    evidence: EvidenceParams = EvidenceParams()
     grow_chunk: float = 4.0  # m: the grid grows by multiples of this
     interest: InterestParams = InterestParams()
 
@@ -442,16 +500,23 @@ def integrate_stereo(
     world, pix, plan = world[ok], pix[ok], plan[ok]
 
     reach = params.explore_range + 2 * m.frame.resolution
-    frame, cells = _covering(m, view.eye[:2] - reach, view.eye[:2] + reach, params.grow_chunk)
-    _mark_scan(cells, frame, view, world, plan, params)
+    frame, evidence, visited = _covering(m, view.eye[:2] - reach, view.eye[:2] + reach, params.grow_chunk)
+    seen = _scan_mask(frame, view, world, plan, params)
     obstacle = (world[:, 2] > params.floor_tolerance) & (world[:, 2] <= params.obstacle_height)
     obstacle &= plan <= params.explore_range
-    rows, cols = frame.cell_of(world[obstacle, :2])
-    cells[rows, cols] = Cell.OBSTACLE
+    hit = np.zeros(frame.shape, dtype=bool)
+    hit[frame.cell_of(world[obstacle, :2])] = True
+    e = params.evidence
+    evidence[seen & ~hit] -= e.miss
+    evidence[hit] += e.hit
+    np.clip(evidence, e.low, e.high, out=evidence)
 
     points, index = _merge_points(m.points, world, params.voxel)
-    edges, interest = _merge_edges(m.edges, m.interest, index[image_edges(pix, params.max_edge_px)])
-    out = ExplorationMap(frame, cells, points, edges, interest)
+    pairs = image_edges(pix, params.max_edge_px)
+    r, _, _ = edge_geometry(world[pairs[:, 0]], world[pairs[:, 1]], view.eye, view.heading)
+    pairs = pairs[r < params.interest.r_never]  # no depth jump: nothing to look behind, not stored
+    edges, interest = _merge_edges(m.edges, m.interest, index[pairs])
+    out = ExplorationMap(frame, evidence, points, edges, interest, visited)
     return reevaluate_interest(out, view.eye, view.heading, params.interest, params.max_range)
 
 
@@ -482,21 +547,16 @@ def scan(
     return edges, np.minimum(np.minimum(ranges, params.explore_range), far / np.cos(centre))
 
 
-def _mark_scan(
-    cells: np.ndarray,
-    frame: GridFrame,
-    view: CameraView,
-    world: np.ndarray,
-    plan: np.ndarray,
-    params: IntegrationParams,
-) -> None:
-    """Mark explored free (in place) the floor between the footprint's near edge and each bin's range."""
+def _scan_mask(
+    frame: GridFrame, view: CameraView, world: np.ndarray, plan: np.ndarray, params: IntegrationParams
+) -> np.ndarray:
+    """The cells (bool) seen as free floor: between the footprint's near edge and each bin's range."""
+    seen = np.zeros(frame.shape, dtype=np.uint8)
     direction, near, _ = footprint(view)
     if not math.isfinite(near) or len(world) == 0:
-        return
+        return seen.astype(bool)
     edges, ranges = scan(view, world, plan, params)
     reach = near / np.cos(edges)  # the image's bottom row: a line on the floor across the axis
-    seen = np.zeros(frame.shape, dtype=np.uint8)
     c, s = np.cos(edges), np.sin(edges)
     units = np.column_stack((c * direction[0] - s * direction[1], s * direction[0] + c * direction[1]))
     for i in np.flatnonzero(ranges > np.maximum(reach[:-1], reach[1:])):
@@ -505,7 +565,7 @@ def _mark_scan(
         )
         quad = np.round(frame.pixel_of(corners) * (1 << _SHIFT)).astype(np.int32)
         cv2.fillConvexPoly(seen, quad, 1, cv2.LINE_8, _SHIFT)
-    cells[(seen > 0) & (cells != Cell.OBSTACLE)] = Cell.FREE
+    return seen > 0
 
 
 def _voxel_keys(points: np.ndarray, voxel: float) -> np.ndarray:
@@ -602,32 +662,49 @@ class TravelCost:
         return self.frame.centre_of(r, c)
 
 
-def traversable(m: ExplorationMap, robot_radius: float) -> np.ndarray:
-    """Known free cells whose clearance to the nearest obstacle cell exceeds ``robot_radius``."""
-    free = m.cells == Cell.FREE
+def clearance(m: ExplorationMap) -> np.ndarray:
+    """Distance (m) from every cell to the nearest obstacle cell (inf without obstacles)."""
     obstacle = m.cells == Cell.OBSTACLE
     if not obstacle.any():
-        return free
-    clearance = ndimage.distance_transform_edt(~obstacle, sampling=m.frame.resolution)
-    return free & (clearance > robot_radius)
+        return np.full(m.frame.shape, np.inf)
+    return ndimage.distance_transform_edt(~obstacle, sampling=m.frame.resolution)
 
 
-def travel_cost(m: ExplorationMap, start: tuple[float, float], robot_radius: float) -> TravelCost:
-    """G from ``start`` to every cell: 8-connected Dijkstra over :func:`traversable` cells."""
+def traversable(m: ExplorationMap, robot_radius: float) -> np.ndarray:
+    """Known free cells whose clearance to the nearest obstacle cell exceeds ``robot_radius``, and
+    the robot's trail (``visited``: it fitted there)."""
+    return ((m.cells == Cell.FREE) & (clearance(m) > robot_radius)) | m.visited
+
+
+def travel_cost(
+    m: ExplorationMap, start: tuple[float, float], robot_radius: float, *, margin: float = 0.0, penalty: float = 0.0
+) -> TravelCost:
+    """G from ``start`` to every cell: 8-connected Dijkstra over :func:`traversable` cells.
+
+    Steps cost their length; with ``margin`` > 0, a step between cells with less clearance than
+    ``robot_radius + margin`` costs up to ``1 + penalty`` times its length (a linear ramp, like a
+    costmap's inflation), so that paths keep off obstacles where there is room and G counts the
+    care a squeeze takes. Without (the default), G is the path length in metres.
+    """
     frame = m.frame
     cost = np.full(frame.shape, np.inf)
     previous = np.full(frame.shape, -1, dtype=np.int64)
-    ok = traversable(m, robot_radius)
+    room = clearance(m)
+    ok = ((m.cells == Cell.FREE) & (room > robot_radius)) | m.visited
     source = _snap(ok, frame, start, robot_radius)
     if source is None:
         return TravelCost(frame, _readonly(cost), _readonly(previous))
     (sr, sc), snap = source
     rows, cols = np.nonzero(ok)
-    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1  # Dijkstra on the bounding box
-    sub = ok[r0:r1, c0:c1]
+    box = (slice(rows.min(), rows.max() + 1), slice(cols.min(), cols.max() + 1))  # Dijkstra on the bounding box
+    r0, c0 = box[0].start, box[1].start
+    sub = ok[box]
+    weight = np.ones(sub.shape)
+    if margin > 0.0:
+        weight += penalty * np.clip((robot_radius + margin - room[box]) / margin, 0.0, 1.0)
     node = np.full(sub.shape, -1, dtype=np.int64)
     node[sub] = np.arange(np.count_nonzero(sub))
-    graph = _grid_graph(sub, node, frame.resolution)
+    graph = _grid_graph(sub, node, weight, frame.resolution)
     dist, pred = dijkstra(graph, directed=False, indices=int(node[sr - r0, sc - c0]), return_predecessors=True)
     sub_rows, sub_cols = np.nonzero(sub)
     cost[sub_rows + r0, sub_cols + c0] = dist + snap
@@ -658,16 +735,17 @@ def _snap(
     return (int(wr[best] + r0), int(wc[best] + c0)), float(d[best])
 
 
-def _grid_graph(ok: np.ndarray, node: np.ndarray, res: float) -> coo_matrix:
-    """The 8-connected graph of the ``ok`` cells (undirected: each pair once), step costs in metres."""
+def _grid_graph(ok: np.ndarray, node: np.ndarray, weight: np.ndarray, res: float) -> coo_matrix:
+    """The 8-connected graph of the ``ok`` cells (undirected: each pair once): step length times the
+    mean ``weight`` of its two cells."""
     heads, tails, weights = [], [], []
     rows, cols = ok.shape
-    for dr, dc, w in ((0, 1, res), (1, 0, res), (1, 1, res * math.sqrt(2.0)), (1, -1, res * math.sqrt(2.0))):
+    for dr, dc, length in ((0, 1, res), (1, 0, res), (1, 1, res * math.sqrt(2.0)), (1, -1, res * math.sqrt(2.0))):
         a = (slice(0, rows - dr), slice(max(0, -dc), cols - max(0, dc)))
         b = (slice(dr, rows), slice(max(0, dc), cols - max(0, -dc)))
         both = ok[a] & ok[b]
         heads.append(node[a][both])
         tails.append(node[b][both])
-        weights.append(np.full(int(both.sum()), w))
+        weights.append(length * (weight[a][both] + weight[b][both]) / 2.0)
     n = int(ok.sum())
     return coo_matrix((np.concatenate(weights), (np.concatenate(heads), np.concatenate(tails))), shape=(n, n)).tocsr()

@@ -23,7 +23,12 @@ Choices where the paper is vague:
 - Frontier mode: the paper says "closest obstacle". A goal has to be a place the robot can reach
   whose neighbourhood is unexplored, so here it is the reachable border point with the smallest
   travel cost (explore_lite's closest frontier).
-- DONE is absorbing (the mission has succeeded); a new :class:`ModeSwitch` starts over.
+- DONE is absorbing (the mission has succeeded); a new :class:`ModeSwitch` starts over. The
+  paper ends at the first selection without a reachable border; ``patience`` > 1 waits for that
+  many in a row, and in between :func:`select_goal` returns no goal in a mode that is not DONE:
+  the behaviour looks around (:func:`maps.exploration_gaze.survey`) and asks again: a second
+  look clears the speckle of the stereo matcher in a doorway (see ``EvidenceParams``), though
+  not walls smeared by odometry drift.
 - A point the robot went for once and reached is ``spent`` (:meth:`ModeSwitch.spend`): it can no
   longer attract, so a point whose surroundings cannot be explored (under a desk, behind glass)
   does not hold the robot forever. Spent points do not count for "a point has d > K" either.
@@ -59,30 +64,40 @@ class GoalParams:
     k: float = 1.0  # m: a point must lie farther than this beyond the border to attract
     robot_radius: float = 0.26  # m: clearance the path keeps from obstacle cells
     min_frontier: float = 0.3  # m: shorter border pieces are ignored
+    margin: float = 0.0  # m: steps with less clearance than robot_radius + margin cost more...
+    penalty: float = 0.0  # ...up to (1 + penalty) times their length (see maps.exploration.travel_cost)
+    patience: int = 1  # selections in a row without a reachable border before DONE (1: the paper)
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.eta <= 0.5:
             raise ValueError(f"eta must be in [0, 0.5] (eq. 1), got {self.eta}")
-        if self.k < 0.0 or self.robot_radius < 0.0 or self.min_frontier < 0.0:
-            raise ValueError("k, robot_radius and min_frontier must not be negative")
+        if min(self.k, self.robot_radius, self.min_frontier, self.margin, self.penalty) < 0.0:
+            raise ValueError("k, robot_radius, min_frontier, margin and penalty must not be negative")
+        if self.patience < 1:
+            raise ValueError(f"patience must be at least 1, got {self.patience}")
 
 
 @dataclass(frozen=True, slots=True)
 class ModeSwitch:
     """The mode of goal selection and the points already spent: a pure state machine.
 
-    ATTRACTION <-> FRONTIER on whether some point has d > K; any mode -> DONE when no border is
-    reachable; DONE stays.
+    ATTRACTION <-> FRONTIER on whether some point has d > K; any mode -> DONE when no border has
+    been reachable ``patience`` times in a row (``strikes`` counts them; the mode stays as it
+    was meanwhile); DONE stays.
     """
 
     mode: Mode = Mode.ATTRACTION
     spent: frozenset[int] = field(default_factory=frozenset)
+    strikes: int = 0
 
-    def next(self, *, point_beyond_k: bool, border_reachable: bool) -> ModeSwitch:
+    def next(self, *, point_beyond_k: bool, border_reachable: bool, patience: int = 1) -> ModeSwitch:
         """The mode after seeing the current evidence."""
-        if self.mode is Mode.DONE or not border_reachable:
-            return replace(self, mode=Mode.DONE)
-        return replace(self, mode=Mode.ATTRACTION if point_beyond_k else Mode.FRONTIER)
+        if self.mode is Mode.DONE:
+            return self
+        if not border_reachable:
+            strikes = self.strikes + 1
+            return replace(self, mode=Mode.DONE if strikes >= patience else self.mode, strikes=strikes)
+        return replace(self, mode=Mode.ATTRACTION if point_beyond_k else Mode.FRONTIER, strikes=0)
 
     def spend(self, point: int | None) -> ModeSwitch:
         """This switch with ``point`` (an index into the map's points) no longer attracting."""
@@ -130,7 +145,7 @@ def attractive_power(distance: np.ndarray, cost: np.ndarray, eta: float) -> np.n
 
 def candidates(m: ExplorationMap, robot: tuple[float, float], params: GoalParams = GoalParams()) -> Candidates:
     """Reachable border points, and d, P_b and A_P (eq. 1) of every map point, seen from ``robot``."""
-    travel = travel_cost(m, robot, params.robot_radius)
+    travel = travel_cost(m, robot, params.robot_radius, margin=params.margin, penalty=params.penalty)
     min_cells = max(1, int(math.ceil(params.min_frontier / m.frame.resolution)))
     rows, cols = np.nonzero(borders(m, min_cells) & np.isfinite(travel.cost))
     border = m.frame.centre_of(rows, cols)
@@ -147,7 +162,10 @@ def candidates(m: ExplorationMap, robot: tuple[float, float], params: GoalParams
 def select_goal(
     switch: ModeSwitch, m: ExplorationMap, robot: tuple[float, float], params: GoalParams = GoalParams()
 ) -> tuple[ModeSwitch, Goal | None]:
-    """The next mode and goal (None when done) for a robot at ``robot`` (odometry x, y)."""
+    """The next mode and goal for a robot at ``robot`` (odometry x, y).
+
+    No goal: DONE, or (with ``patience`` > 1) no border reachable yet again: look around, retry.
+    """
     if not np.any(m.cells == Cell.FREE):
         raise ValueError("the exploration map has no explored free cell: mark the robot's footprint first")
     if switch.mode is Mode.DONE:
@@ -156,8 +174,9 @@ def select_goal(
     eligible = found.distance > params.k
     if switch.spent:
         eligible[np.fromiter(switch.spent, dtype=np.int64)] = False
-    switch = switch.next(point_beyond_k=bool(eligible.any()), border_reachable=len(found.border) > 0)
-    if switch.mode is Mode.DONE:
+    reachable = len(found.border) > 0
+    switch = switch.next(point_beyond_k=bool(eligible.any()), border_reachable=reachable, patience=params.patience)
+    if switch.mode is Mode.DONE or not reachable:
         return switch, None
     if switch.mode is Mode.ATTRACTION:
         point = int(np.argmax(np.where(eligible, found.power, -np.inf)))

@@ -34,7 +34,7 @@ SIMPLE = StereoHead(ptu=(0.0, 0.0, 1.0), camera=(0.0, 0.0, 0.0), vertical_fov=ma
 def grid_map(cells: np.ndarray, resolution: float = 0.1, **arrays: np.ndarray) -> ExplorationMap:
     """A map whose cell (row, col) has its lower-left corner at (col * res, row * res)."""
     frame = GridFrame(0.0, 0.0, resolution, *cells.shape)
-    return ExplorationMap(frame, cells.astype(np.uint8), **arrays)
+    return ExplorationMap.from_cells(frame, cells, **arrays)
 
 
 def apart(points: np.ndarray) -> np.ndarray:
@@ -61,10 +61,14 @@ def test_grid_frame_cells_centres_and_growth():
     assert (grown.x0, grown.y0, grown.rows, grown.cols) == (-3.0, -1.0, 4, 8)
 
 
-def test_map_arrays_are_read_only():
+def test_map_arrays_are_read_only_and_cells_follow_the_evidence():
     m = ExplorationMap.empty(resolution=0.1, half_size=1.0)
     with pytest.raises(ValueError):
+        m.evidence[0, 0] = -1.0
+    with pytest.raises(ValueError):
         m.cells[0, 0] = Cell.FREE
+    evidence = np.array([[-0.4, 0.0, 0.45]], dtype=np.float32)
+    assert ExplorationMap(GridFrame(0, 0, 0.1, 1, 3), evidence).cells.tolist() == [[1, 0, 2]]
 
 
 def test_head_view_places_the_left_camera_like_the_simulator():
@@ -126,9 +130,7 @@ def test_a_wall_explores_the_floor_between_the_footprint_and_the_wall():
 def test_floor_points_explore_up_to_the_explore_range_only():
     xs, ys = np.meshgrid(np.linspace(1.0, 5.0, 81), np.linspace(-0.5, 0.5, 21))
     floor = np.column_stack((xs.ravel(), ys.ravel(), np.full(xs.size, -1.0)))  # world z = 0
-    m = integrate_stereo(
-        ExplorationMap.empty(resolution=0.1), floor, apart(floor), SIMPLE.view(Pose2D(), 0.0, 0.0)
-    )
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), floor, apart(floor), SIMPLE.view(Pose2D(), 0.0, 0.0))
     assert state_at(m, 2.85, 0.05) == Cell.FREE
     assert state_at(m, 3.25, 0.05) == Cell.UNKNOWN
     assert not np.any(m.cells == Cell.OBSTACLE)
@@ -137,9 +139,7 @@ def test_floor_points_explore_up_to_the_explore_range_only():
 
 def test_points_above_the_robot_mark_nothing_but_are_kept():
     ceiling = wall_observation(z=1.5)  # world z = 2.5, above obstacle_height
-    m = integrate_stereo(
-        ExplorationMap.empty(resolution=0.1), ceiling, apart(ceiling), SIMPLE.view(Pose2D(), 0.0, 0.0)
-    )
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), ceiling, apart(ceiling), SIMPLE.view(Pose2D(), 0.0, 0.0))
     assert not np.any(m.cells != Cell.UNKNOWN)
     assert len(m.points) == 45  # 441 points 1 cm apart in 0.1 m voxels
 
@@ -153,15 +153,23 @@ def test_observations_use_the_odometry_pose_and_pan():
     assert m.points[:, 2] == pytest.approx(np.ones(len(m.points)))
 
 
-def test_obstacles_are_sticky_until_the_robot_stands_there():
+def test_obstacle_evidence_clears_when_the_floor_is_seen_there_again():
     points = wall_observation()
     view = SIMPLE.view(Pose2D(), 0.0, 0.0)
     m = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points), view)
+    assert m.evidence[m.frame.cell_of(np.array([[2.05, 0.05]]))][0] == pytest.approx(0.85)
     xs, ys = np.meshgrid(np.linspace(1.0, 2.9, 39), np.linspace(-0.3, 0.3, 13))
     floor = np.column_stack((xs.ravel(), ys.ravel(), np.full(xs.size, -1.0)))
-    m = integrate_stereo(m, floor, apart(floor), view)  # floor seen "through" the wall
-    assert state_at(m, 2.05, 0.05) == Cell.OBSTACLE
+    for sightings, expected in ((1, Cell.OBSTACLE), (2, Cell.OBSTACLE), (3, Cell.FREE)):  # 0.85 - n * 0.4
+        m = integrate_stereo(m, floor, apart(floor), view)
+        assert state_at(m, 2.05, 0.05) == expected, sightings
     assert state_at(m, 2.55, 0.05) == Cell.FREE
+    assert state_at(m, 2.05, 0.55) == Cell.OBSTACLE  # outside the floor patch: still the wall
+
+
+def test_the_robots_disc_is_free_whatever_was_seen_there():
+    points = wall_observation()
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points), SIMPLE.view(Pose2D(), 0.0, 0.0))
     m = mark_traversed(m, Pose2D(2.05, 0.05), 0.26)
     assert state_at(m, 2.05, 0.05) == Cell.FREE and state_at(m, 2.05, 0.25) == Cell.FREE
     assert state_at(m, 2.05, 0.45) == Cell.OBSTACLE
@@ -176,13 +184,16 @@ def test_mark_traversed_grows_the_grid_and_marks_a_disc():
 
 
 def test_the_same_observation_twice_adds_nothing():
-    points = wall_observation()
+    # a near wall on the right, a far one on the left, every point 5 px from the next in the image
+    near, far = wall_observation(2.05), wall_observation(4.05)
+    points = np.concatenate([near[near[:, 1] < 0], far[far[:, 1] >= 0]])
     uv = np.column_stack((np.arange(len(points)) * 5.0, np.zeros(len(points))))
     view = SIMPLE.view(Pose2D(), 0.0, 0.0)
     once = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, uv, view)
     twice = integrate_stereo(once, points, uv, view)
-    assert len(twice.points) == len(once.points) == 45
-    assert len(twice.edges) == len(once.edges) == 44  # neighbouring voxels along the wall
+    assert len(twice.points) == len(once.points) == 22 + 23  # 0.1 m voxels of y in [-2.2, 0) and [0, 2.2]
+    # only the neighbours across the depth jump make an edge (r = 2.05 / 4.05); along a wall r ~ 1
+    assert once.edges.tolist() == twice.edges.tolist() == [[21, 22]]
     assert np.array_equal(twice.cells, once.cells)
 
 
@@ -290,3 +301,26 @@ def test_travel_cost_only_crosses_known_free_space_and_snaps_the_start():
     # the start cell is too close to the obstacle: it snaps to the nearest traversable cell, 0.1 m away
     assert cost.at(np.array([[0.25, 0.05]]))[0] == pytest.approx(0.2)
     assert cost.at(np.array([[0.55, 0.05]]))[0] == pytest.approx(0.1 + 0.4)
+
+
+def test_steps_near_obstacles_cost_more_with_a_margin():
+    cells = np.array([[Cell.FREE, Cell.FREE, Cell.FREE], [Cell.UNKNOWN, Cell.OBSTACLE, Cell.UNKNOWN]])
+    m = grid_map(cells)
+    assert travel_cost(m, (0.05, 0.05), 0.05).at(np.array([[0.25, 0.05]]))[0] == pytest.approx(0.2)
+    # clearance 0.1 * sqrt 2 at the ends, 0.1 in the middle: weights 1 + (0.25 - clearance) / 0.2
+    end, middle = 1 + (0.25 - 0.1 * math.sqrt(2)) / 0.2, 1 + (0.25 - 0.1) / 0.2
+    slow = travel_cost(m, (0.05, 0.05), 0.05, margin=0.2, penalty=1.0)
+    assert slow.at(np.array([[0.25, 0.05]]))[0] == pytest.approx(2 * 0.1 * (end + middle) / 2)
+
+
+def test_the_robots_trail_stays_traversable_through_a_squeeze():
+    m = grid_map(np.full((3, 12), Cell.FREE))
+    for x in np.arange(0.15, 1.1, 0.05):  # the robot drove along the middle row
+        m = mark_traversed(m, Pose2D(x, 0.15), 0.05, chunk_m=0.1)
+    evidence = m.evidence.copy()
+    evidence[m.frame.cell_of(np.array([[0.55, 0.05], [0.55, 0.25], [0.65, 0.05], [0.65, 0.25]]))] = 1.0
+    squeezed = ExplorationMap(m.frame, evidence, visited=m.visited)  # obstacles seen since on both sides
+    target = np.array([[1.05, 0.15]])
+    assert travel_cost(squeezed, (0.15, 0.15), robot_radius=0.1).at(target)[0] == pytest.approx(0.9)
+    forgotten = ExplorationMap(m.frame, evidence)  # the same map without the trail
+    assert travel_cost(forgotten, (0.15, 0.15), robot_radius=0.1).at(target)[0] == math.inf

@@ -62,7 +62,7 @@ def edge_map(*edges: tuple[list[float], list[float], Interest]) -> ExplorationMa
     points = np.array([p for a, b, _ in edges for p in (a, b)], dtype=np.float64)
     pairs = np.arange(len(points)).reshape(-1, 2)
     states = np.array([s for _, _, s in edges], dtype=np.uint8)
-    return ExplorationMap(GridFrame(0.0, 0.0, 0.1, 2, 2), np.zeros((2, 2), np.uint8), points, pairs, states)
+    return ExplorationMap(GridFrame(0.0, 0.0, 0.1, 2, 2), np.zeros((2, 2), np.float32), points, pairs, states)
 
 
 LEFT = ([2.1, 1.0, 1.08], [4.0, 2.0, 1.0], Interest.WATCH_NOW)  # bearing atan(1/2) from the axis at (0.1, 0)
@@ -111,10 +111,10 @@ def test_turn_to_pa_when_the_point_leaves_the_view_then_back_to_the_front():
 def test_a_followed_edge_stays_watched_after_leaving_the_now_cone_until_90_degrees():
     m = edge_map(LEFT)
     gaze, _ = next_gaze(Gaze(), m, Pose2D(), now=0.0, params=PARAMS)
-    later = ExplorationMap(m.frame, m.cells, m.points, m.edges, np.array([Interest.WATCH_LATER], np.uint8))
+    later = ExplorationMap(m.frame, m.evidence, m.points, m.edges, np.array([Interest.WATCH_LATER], np.uint8))
     gaze, cmd = next_gaze(gaze, later, Pose2D(1.5, 0.0, 0.0), now=0.1, params=PARAMS)  # 63 degrees off
     assert gaze.target == 0 and cmd.pan == pytest.approx(math.atan2(1.0, 0.5))
-    never = ExplorationMap(m.frame, m.cells, m.points, m.edges, np.array([Interest.NEVER], np.uint8))
+    never = ExplorationMap(m.frame, m.evidence, m.points, m.edges, np.array([Interest.NEVER], np.uint8))
     gaze, cmd = next_gaze(gaze, never, Pose2D(1.5, 0.0, 0.0), now=0.2, params=PARAMS)
     assert gaze.target is None and cmd.pan == 0.0
 

@@ -23,7 +23,7 @@ def explored_strip(points: list[list[float]], *, walled: bool = False) -> Explor
         cells[[0, 11], 0:22] = Cell.OBSTACLE
         cells[0:12, [0, 21]] = Cell.OBSTACLE
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    return ExplorationMap(GridFrame(-0.1, -0.1, 0.1, 31, 41), cells, points=pts)
+    return ExplorationMap.from_cells(GridFrame(-0.1, -0.1, 0.1, 31, 41), cells, points=pts)
 
 
 P1 = [4.0, 0.55, 0.5]  # east: nearest border (1.95, 0.55), d = 2.05, G = 17 cells = 1.7
@@ -94,7 +94,7 @@ def test_borders_beyond_a_gap_the_robot_cannot_pass_do_not_count():
     m = explored_strip([P1], walled=True)
     cells = m.cells.copy()
     cells[6, 21:23] = Cell.FREE  # a 0.1 m slot in the east wall at y = 0.55, explored floor behind it
-    m = ExplorationMap(m.frame, cells, points=m.points)
+    m = ExplorationMap.from_cells(m.frame, cells, points=m.points)
     switch, goal = select_goal(ModeSwitch(), m, ROBOT, NO_RADIUS)  # a point robot fits through
     assert switch.mode is Mode.ATTRACTION and goal is not None and goal.target == pytest.approx((2.15, 0.55))
     wide = GoalParams(eta=0.25, k=1.0, robot_radius=0.1, min_frontier=0.1)
@@ -110,6 +110,20 @@ def test_mode_switch_transitions():
     for s in (a, f, d):
         assert s.next(point_beyond_k=True, border_reachable=False).mode is Mode.DONE
     assert d.next(point_beyond_k=True, border_reachable=True).mode is Mode.DONE
+    # patience: DONE only after that many selections in a row without a reachable border
+    once = f.next(point_beyond_k=False, border_reachable=False, patience=2)
+    assert (once.mode, once.strikes) == (Mode.FRONTIER, 1)
+    assert once.next(point_beyond_k=False, border_reachable=True, patience=2).strikes == 0
+    assert once.next(point_beyond_k=False, border_reachable=False, patience=2).mode is Mode.DONE
+
+
+def test_patience_gives_no_goal_before_done():
+    walled = explored_strip([P1], walled=True)
+    params = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, patience=2)
+    switch, goal = select_goal(ModeSwitch(), walled, ROBOT, params)
+    assert switch.mode is Mode.ATTRACTION and goal is None  # look around, then ask again
+    switch, goal = select_goal(switch, walled, ROBOT, params)
+    assert switch.mode is Mode.DONE and goal is None
 
 
 def test_selection_needs_the_robots_footprint_first():
