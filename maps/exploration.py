@@ -247,7 +247,7 @@ class ExplorationMap:
         names = ("frame", "evidence", "points", "edges", "interest", "visited")
         values = {name: getattr(self, name) for name in names}
         values.update(changes)
-        return ExplorationMap(**values)  # type: ignore[arg-type]
+        return ExplorationMap(**values)
 
 
 def _covering(

@@ -199,7 +199,6 @@ def _fake_results(folder):
 
 
 def test_summary_and_plot_of_earlier_results(tmp_path, capsys):
-    pytest.importorskip("matplotlib")
     _fake_results(tmp_path / "res")
     assert sweep("--summary", str(tmp_path / "res"), "--plot", "goal_error_m", "--against", "speed") == 0
     out = capsys.readouterr().out

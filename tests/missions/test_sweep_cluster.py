@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import json
 
-import pytest
+import distributed  # a dev dependency: its absence fails the test, it never skips it
 
 from missions.cli import main
 from missions.sweep import comparable
-
-distributed = pytest.importorskip("distributed")
 
 
 def rows_of(folder) -> list[dict]:
