@@ -103,15 +103,18 @@ def btcpp_xml(mission: MissionSpec) -> str:
     express raises :class:`~maps.store.InputError` located at the node.
     """
     exporter = _BtcppExporter(mission.registry)
-    main_id = _ident(mission.name)
-    root = ET.Element("root", {"BTCPP_format": "4", "main_tree_to_execute": main_id})
-    ET.SubElement(root, "BehaviorTree", {"ID": main_id}).append(exporter.element(mission.tree))
-    if mission.sense:
-        sense = ET.SubElement(root, "BehaviorTree", {"ID": main_id + SENSE_SUFFIX})
-        sequence = ET.SubElement(sense, "Sequence", {"name": SENSE_NAME})
-        sequence.extend(exporter.element(node) for node in mission.sense)
+    task = exporter.element(mission.tree)
+    sense = [exporter.element(node) for node in mission.sense]
     if exporter.problems:
         raise InputError(exporter.problems)
+    main_id = _ident(mission.name)
+    if main_id in BUILTIN_NAMES or main_id in exporter.models:  # BT.CPP: a tree ID is no node type's name
+        main_id += "Tree"
+    root = ET.Element("root", {"BTCPP_format": "4", "main_tree_to_execute": main_id})
+    ET.SubElement(root, "BehaviorTree", {"ID": main_id}).append(task)
+    if sense:
+        tree = ET.SubElement(root, "BehaviorTree", {"ID": main_id + SENSE_SUFFIX})
+        ET.SubElement(tree, "Sequence", {"name": SENSE_NAME}).extend(sense)
     model = ET.SubElement(root, "TreeNodesModel")
     for tag, node_type in sorted(exporter.models.items()):
         element = ET.SubElement(model, BTCPP_MODEL_TAG[node_type.kind], {"ID": tag})

@@ -23,6 +23,7 @@ came from. Nothing is written unless the mission validates.
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
@@ -73,8 +74,9 @@ class _Refused(Exception):
 
 def parse_xml(data: bytes, file: str) -> XmlElement:
     """Parse XML bytes into located elements; malformed XML and any DOCTYPE (hence any entity
-    declaration) are an :class:`InputError` at their line. Text and comments are ignored."""
-    parser = expat.ParserCreate()
+    declaration) are an :class:`InputError` at their line. The bytes are read as UTF-8 whatever
+    the declaration says (BT.CPP's tinyxml2 reads nothing else). Text and comments are ignored."""
+    parser = expat.ParserCreate(encoding="UTF-8")
     stack: list[XmlElement] = []
     roots: list[XmlElement] = []
 
@@ -609,14 +611,29 @@ def _plain(draft: Draft) -> Any:
     return {draft.type.name: body} if body else draft.type.name
 
 
+class _Dumper(yaml.SafeDumper):
+    """PyYAML's safe dumper, quoting text that YAML 1.2 reads as a number: the mission loader
+    (:func:`maps.store.parse_yaml`) reads ``1e5`` as a float, PyYAML's YAML 1.1 would write it bare."""
+
+
+_Dumper.add_implicit_resolver("tag:yaml.org,2002:float",
+                              re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+                              list("-+0123456789"))
+
+
+def dump_mission(document: dict[str, Any]) -> str:
+    """Plain mission data as YAML text the mission loader reads back to the same values."""
+    return yaml.dump(document, Dumper=_Dumper, sort_keys=False, allow_unicode=True, default_flow_style=None,
+                     width=110)
+
+
 def render(mission: MissionDraft, source: str) -> str:
     """The mission file's text."""
     document: dict[str, Any] = {"mission": mission.name}
     if mission.sense:
         document["sense"] = [_plain(node) for node in mission.sense]
     document["tree"] = _plain(mission.tree)
-    body = yaml.safe_dump(document, sort_keys=False, allow_unicode=True, default_flow_style=None, width=110)
-    return f"# Imported from {source} (BehaviorTree.CPP v4) by bearings import.\n{body}"
+    return f"# Imported from {source} (BehaviorTree.CPP v4) by bearings import.\n{dump_mission(document)}"
 
 
 def _node_lines(text: str, mission: MissionDraft) -> list[tuple[int, Draft]]:

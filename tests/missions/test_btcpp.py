@@ -23,7 +23,6 @@ from typing import Any
 
 import behaviortreepy as bt
 import pytest
-import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -33,7 +32,7 @@ from maps.store import InputError
 from missions.btcpp import BUILTIN_NAMES, identifier_to_key, key_to_identifier, parse_comparison, script_literal
 from missions.cli import main
 from missions.export import btcpp_xml
-from missions.importer import import_btcpp
+from missions.importer import dump_mission, import_btcpp
 from missions.language import NodeSpec
 from missions.loader import LIBRARY, load_mission
 from tests.fuzzing import examples
@@ -315,8 +314,8 @@ def test_bearings_import_writes_a_mission_that_validates(tmp_path, capsys):
 # -- generated trees ---------------------------------------------------------------------------------
 BUILTIN = Registry.builtin()
 FLOAT_REFS = ("/robot/odometry.x", "/robot/odometry.y", "/robot/odometry.theta")
-names = st.text(st.characters(blacklist_categories=("Cc", "Cs"), blacklist_characters="$"), min_size=1,
-                max_size=8).filter(lambda s: s.strip() != "")
+names = st.text(st.characters(blacklist_categories=("Cc", "Cs"), blacklist_characters="$",
+                              whitelist_characters="\t\n\x85"), min_size=1, max_size=8).filter(lambda s: s.strip())
 texts = st.text(st.characters(blacklist_categories=("Cc", "Cs"), blacklist_characters="${}"), max_size=6)
 map_keys = st.lists(st.from_regex(r"[A-Za-z0-9_é]{1,6}", fullmatch=True), min_size=1, max_size=3).map(
     lambda parts: "/map/out/" + "/".join(parts))
@@ -403,8 +402,7 @@ def trees(draw, depth: int = 3) -> Any:
 def test_generated_trees_load_in_btcpp_and_survive_export_and_import(tmp_path_factory, tree, sense):
     folder = tmp_path_factory.mktemp("generated")
     path = folder / "generated.yaml"
-    path.write_text(yaml.safe_dump({"mission": "generated", "sense": sense, "tree": tree}, allow_unicode=True),
-                    encoding="utf-8")
+    path.write_text(dump_mission({"mission": "generated", "sense": sense, "tree": tree}), encoding="utf-8")
     original, imported = round_trip(path, folder)
     assert imported == original
 
@@ -428,6 +426,12 @@ def test_the_export_reports_what_btcpp_cannot_express_at_the_node(write_mission,
     assert message in caught.value.diagnostics[0].message
     assert main(["show", str(path), "--format", "xml"]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_a_mission_named_like_a_node_type_gets_a_tree_id_btcpp_accepts(write_mission):
+    path = write_mission("mission: Stop\ntree: Stop\n")
+    xml = btcpp_xml(load_mission(path))
+    assert 'main_tree_to_execute="StopTree"' in xml and set(load_in_btcpp(xml)) == {"StopTree"}
 
 
 def test_a_float_port_keeps_every_digit(write_mission):

@@ -4,15 +4,19 @@ reported at its line, and nothing is written then."""
 
 from __future__ import annotations
 
+import re
 import textwrap
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, event, given, settings
+from hypothesis import strategies as st
 
 from maps.store import InputError
 from missions.cli import main
 from missions.importer import import_btcpp
-from missions.loader import load_mission
+from missions.loader import LIBRARY, load_mission
+from tests.fuzzing import examples, load_or_diagnose
 
 GROOT2_FILE = """\
 <?xml version="1.0" encoding="UTF-8"?>
@@ -231,3 +235,102 @@ def test_the_file_size_is_bounded(tmp_path, monkeypatch):
     monkeypatch.setattr("missions.importer.MAX_FILE_BYTES", 100)
     found = problems(tmp_path, _tree("<Stop/>" * 20))
     assert len(found) == 1 and found[0].startswith("larger than") and "not a BehaviorTree.CPP XML file" in found[0]
+
+
+def test_the_subtree_example_of_the_documentation_imports_as_it_says(tmp_path, write_mission):
+    page = (Path(__file__).resolve().parents[2] / "docs" / "missions.md").read_text()
+    section = page[page.index("### Subtrees"):]
+    xml = re.search(r"```xml\n(.*?)```", section, re.S).group(1)
+    imported = tmp_path / "patrol.yaml"
+    imported.write_text(import_btcpp(_write(tmp_path, xml)), encoding="utf-8")
+    expected = write_mission("""
+        tree:
+          Sequence:
+            children:
+              - Guard: {name: first corner, key: /robot/stalled, value: false, child: {DriveTo: {x: 2.0, y: 0.5}}}
+              - Guard: {name: home, key: /robot/stalled, value: false, child: {DriveTo: {x: 0.0, y: 0.0}}}
+              - Stop
+    """)
+    assert _shape(load_mission(imported).tree) == _shape(load_mission(expected).tree)
+
+
+def _export(path: Path) -> bytes:
+    from missions.export import btcpp_xml
+
+    return btcpp_xml(load_mission(path)).encode()
+
+
+SEEDS = [GROOT2_FILE.encode(), *(_export(p) for p in sorted(LIBRARY.glob("*.yaml")))]
+PIECES = [b"<", b">", b"/>", b'"', b"{", b"}", b"@", b"&lt;", b"&amp;", b"<SubTree ID='GoTo'/>", b"\xff",
+          b"<Sequence>", b"</Sequence>", b" _autoremap='true'", b" _skipIf='x'", b"{=}", b"<!DOCTYPE x>", b"\n"]
+
+
+@st.composite
+def mutated_files(draw) -> bytes:
+    data = bytearray(draw(st.sampled_from(SEEDS)))
+    for _ in range(draw(st.integers(1, 5))):
+        pos = draw(st.integers(0, len(data)))
+        op = draw(st.sampled_from(["delete", "insert", "replace"]))
+        if op == "delete":
+            del data[pos:pos + draw(st.integers(1, 30))]
+        elif op == "insert":
+            data[pos:pos] = draw(st.sampled_from(PIECES))
+        elif data:
+            data[min(pos, len(data) - 1)] = draw(st.integers(0, 255))
+    return bytes(data)
+
+
+TAGS = ["Sequence", "ReactiveSequence", "Fallback", "Parallel", "SubTree", "Timeout", "RunOnce", "Precondition",
+        "ScriptCondition", "Sleep", "Drive", "Stop", "Guard", "Action", "BehaviorTree", "TreeNodesModel",
+        "input_port", "RecoveryNode", "RateController", "OneShot", "IfThenElse", "KeepRunningUntilFailure", "root"]
+ATTRIBUTES = ["ID", "name", "msec", "if", "else", "code", "success_count", "failure_count", "then_skip", "gx",
+              "distance", "command", "_autoremap", "_skipIf", "main_tree_to_execute", "BTCPP_format", "default",
+              "num_attempts", "policy", "key", "value", "hz"]
+VALUES = ["1", "-1", "0.5", "abc", "true", "false", "{@robot__command}", "{=}", "{gx}", "{@_zz}", "{/robot/stalled}",
+          "@robot__stalled == true", "@robot__odometry___x &lt; 1 &amp;&amp; x", "GoTo", "Patrol", "Pause", "",
+          "SUCCESS", "{@perception__observation___count}", "3000000000", "1e999"]
+
+
+@st.composite
+def rearranged_files(draw) -> bytes:
+    """Well-formed XML whose elements and attributes are shuffled among BT.CPP's vocabulary."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.fromstring(draw(st.sampled_from(SEEDS)))
+    for _ in range(draw(st.integers(1, 6))):
+        elements = list(root.iter())
+        element = draw(st.sampled_from(elements))
+        op = draw(st.sampled_from(["tag", "attribute", "drop_attribute", "remove", "duplicate", "move"]))
+        if op == "tag":
+            element.tag = draw(st.sampled_from(TAGS))
+        elif op == "attribute":
+            element.set(draw(st.sampled_from(ATTRIBUTES)), draw(st.sampled_from(VALUES)))
+        elif op == "drop_attribute" and element.attrib:
+            del element.attrib[draw(st.sampled_from(sorted(element.attrib)))]
+        elif len(element):
+            child = draw(st.sampled_from(list(element)))
+            if op == "remove":
+                element.remove(child)
+            elif op == "duplicate":
+                element.append(ET.fromstring(ET.tostring(child)))
+            else:
+                element.remove(child)
+                inside = set(map(id, child.iter()))
+                draw(st.sampled_from([e for e in elements if id(e) not in inside])).append(child)
+    return ET.tostring(root)
+
+
+@settings(max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.one_of(mutated_files(), rearranged_files(), st.binary(max_size=100)))
+def test_whatever_the_file_holds_import_gives_a_mission_or_located_problems(data):
+    result = load_or_diagnose(data, import_btcpp, name="tree.xml")
+    assert result is None or result.startswith("# Imported from tree.xml")
+    event("imported" if result else "reported")
+
+
+def test_text_that_yaml_1_2_reads_as_a_number_stays_text(tmp_path):
+    path = _write(tmp_path, _tree('<Perceive camera="1e5" name="2E-3"/>'))
+    mission = tmp_path / "m.yaml"
+    mission.write_text(import_btcpp(path), encoding="utf-8")
+    node = load_mission(mission).tree
+    assert (node.inputs["camera"], node.name) == ("1e5", "2E-3")
