@@ -636,10 +636,13 @@ def render(mission: MissionDraft, source: str) -> str:
     return f"# Imported from {source} (BehaviorTree.CPP v4) by bearings import.\n{dump_mission(document)}"
 
 
-def _node_lines(text: str, mission: MissionDraft) -> list[tuple[int, Draft]]:
+Start = tuple[int, int]  # line, column in the rendered mission text
+
+
+def _node_starts(text: str, mission: MissionDraft) -> list[tuple[Start, Draft]]:
     """Where each draft starts in the rendered text, in order (to report the loader's problems in the XML)."""
     data = parse_yaml(text)
-    out: list[tuple[int, Draft]] = []
+    out: list[tuple[Start, Draft]] = []
     sense = data.get("sense", [])
     for index, node in enumerate(mission.sense):
         _lines(sense[index], sense.mark_of(index), node, out)
@@ -647,8 +650,8 @@ def _node_lines(text: str, mission: MissionDraft) -> list[tuple[int, Draft]]:
     return sorted(out, key=lambda item: item[0])
 
 
-def _lines(raw: Any, mark: Mark, draft: Draft, out: list[tuple[int, Draft]]) -> None:
-    out.append((mark.line, draft))
+def _lines(raw: Any, mark: Mark, draft: Draft, out: list[tuple[Start, Draft]]) -> None:
+    out.append(((mark.line, mark.col), draft))
     if not draft.children:
         return
     body = raw[draft.type.name]
@@ -668,17 +671,22 @@ def _validated(text: str, mission: MissionDraft, file: str, registry: Registry |
         try:
             load_mission(path, registry=registry)
         except InputError as exc:
-            lines = _node_lines(text, mission)
-            raise InputError([_in_xml(d, path, file, lines) for d in exc.diagnostics]) from None
+            starts = _node_starts(text, mission)
+            raise InputError([_in_xml(d, path, file, starts) for d in exc.diagnostics]) from None
 
 
-def _in_xml(diagnostic: Diagnostic, path: str, file: str, lines: list[tuple[int, Draft]]) -> Diagnostic:
+def _in_xml(diagnostic: Diagnostic, path: str, file: str, starts: list[tuple[Start, Draft]]) -> Diagnostic:
+    """A problem of the written mission, at the XML node it came from (naming the bearings type
+    the node became when the names differ: ``<RetryUntilSuccessful> as Retry: ...``)."""
     if diagnostic.file != path:
         return diagnostic
-    element = next((d.element for line, d in reversed(lines) if line <= diagnostic.line), None)
-    if element is None:
+    draft = next((d for start, d in reversed(starts) if start <= (diagnostic.line, diagnostic.col)), None)
+    if draft is None:
         return Diagnostic(file, 0, 0, diagnostic.message)
-    return Diagnostic(file, element.line, element.col, diagnostic.message)
+    element = draft.element
+    tag = element.attrs.get("ID", "") if element.tag in MODEL_TAGS else element.tag
+    prefix = "" if tag == draft.type.name else f"<{tag}> as {draft.type.name}: "
+    return Diagnostic(file, element.line, element.col, prefix + diagnostic.message)
 
 
 def import_btcpp(path: str | os.PathLike, *, registry: Registry | None = None) -> str:

@@ -178,6 +178,8 @@ def test_problems_the_mission_loader_finds_are_reported_at_the_xml_node(tmp_path
     assert found[0] == "5:7: Drive.distance expects a number in m, got 'abc'"
     assert found[1].startswith("6:7: Rotate.speed must be <= 300 in deg/s")
     assert len(found) == 2  # the data flow is checked once the nodes are valid
+    found = problems(tmp_path, _tree('<RetryUntilSuccessful num_attempts="-1"><Stop/></RetryUntilSuccessful>'))
+    assert found == ["4:5: <RetryUntilSuccessful> as Retry: Retry.num_attempts must be >= 1, got -1"]
     found = problems(tmp_path, _tree('<Drive distance="{@map__nowhere}"/>'))
     assert len(found) == 1 and found[0].startswith("4:5: Drive.distance reads /map/nowhere, which nothing writes")
 
