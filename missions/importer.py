@@ -23,7 +23,6 @@ came from. Nothing is written unless the mission validates.
 from __future__ import annotations
 
 import os
-import re
 import tempfile
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
@@ -31,12 +30,20 @@ from pathlib import Path
 from typing import Any
 from xml.parsers import expat
 
-import yaml
-
 from behaviours.ports import KEY_PATTERN, REQUIRED, InputPort, OutputPort, Ref, key_problem, parse_ref
 from behaviours.registry import NodeType, Registry
 from maps.located import suggest
-from maps.store import MAX_FILE_BYTES, Diagnostic, InputError, Mark, YamlList, YamlMap, parse_yaml, read_bytes
+from maps.store import (
+    MAX_FILE_BYTES,
+    Diagnostic,
+    InputError,
+    Mark,
+    YamlList,
+    YamlMap,
+    dump_yaml,
+    parse_yaml,
+    read_bytes,
+)
 from missions.btcpp import (
     BUILTIN_PORTS,
     NO_EQUIVALENT,
@@ -611,20 +618,9 @@ def _plain(draft: Draft) -> Any:
     return {draft.type.name: body} if body else draft.type.name
 
 
-class _Dumper(yaml.SafeDumper):
-    """PyYAML's safe dumper, quoting text that YAML 1.2 reads as a number: the mission loader
-    (:func:`maps.store.parse_yaml`) reads ``1e5`` as a float, PyYAML's YAML 1.1 would write it bare."""
-
-
-_Dumper.add_implicit_resolver("tag:yaml.org,2002:float",
-                              re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
-                              list("-+0123456789"))
-
-
 def dump_mission(document: dict[str, Any]) -> str:
     """Plain mission data as YAML text the mission loader reads back to the same values."""
-    return yaml.dump(document, Dumper=_Dumper, sort_keys=False, allow_unicode=True, default_flow_style=None,
-                     width=110)
+    return dump_yaml(document)
 
 
 def render(mission: MissionDraft, source: str) -> str:
