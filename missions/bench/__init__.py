@@ -9,4 +9,5 @@ AREAS = {
     "sim": "missions.bench.sim",
     "perception": "missions.bench.perception",
     "ltmap": "missions.bench.ltmap",
+    "sweep": "missions.bench.sweep",
 }

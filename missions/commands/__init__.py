@@ -8,10 +8,12 @@ COMMANDS = (
     "missions.commands.run",
     "missions.commands.validate",
     "missions.commands.show",
+    "missions.commands.import_",
     "missions.commands.schema",
     "missions.commands.bench",
     "missions.commands.sim",
     "missions.commands.calibrate",
     "missions.commands.doctor",
     "missions.commands.map",
+    "missions.commands.sweep",
 )

@@ -1,0 +1,190 @@
+"""Where to explore next (algorithm 3): attractive power (eq. 1), frontier mode, done.
+
+The next goal is the detected point ``P_p`` with the highest attractive power
+
+    A_P = d(P_p, P_b) - eta * G(v_S, P_b)            (eq. 1, eta in [0, 0.5])
+
+where ``P_b`` is a border point of the explored area, ``d`` the plan distance from the point's
+floor projection to it and ``G`` the travel cost from the robot through known free space
+(:func:`maps.exploration.travel_cost`). When no point lies farther than ``K`` beyond the border,
+the robot is in *frontier mode* until one does; exploration is *done* when no border is
+reachable. The mode switching is the small value :class:`ModeSwitch`, so the behaviour that uses
+it only reads the map, calls :func:`select_goal` and writes the goal.
+
+Choices where the paper is vague:
+
+- ``P_b`` for a point is the reachable border point nearest to it (a k-d tree over the reachable
+  border cells): d says how far into the unknown the point lies, G what reaching the unknown
+  there costs. A point whose floor projection is already explored or an obstacle cell has d = 0.
+  Borders that no path reaches do not count for d (they are the ones exploration cannot use).
+- The goal to drive to is ``P_b``, not ``P_p``: ``P_p`` may be a wall seen 7 m away, while ``P_b``
+  is reachable through known free space by construction; on arrival the cameras see further and
+  the next selection moves on.
+- Frontier mode: the paper says "closest obstacle". A goal has to be a place the robot can reach
+  whose neighbourhood is unexplored, so here it is the reachable border point with the smallest
+  travel cost (explore_lite's closest frontier).
+- DONE is absorbing (the mission has succeeded); a new :class:`ModeSwitch` starts over. The
+  paper ends at the first selection without a reachable border; ``patience`` > 1 waits for that
+  many in a row, and in between :func:`select_goal` returns no goal in a mode that is not DONE:
+  the behaviour looks around (:func:`maps.exploration_gaze.survey`) and asks again: a second
+  look clears the speckle of the stereo matcher in a doorway (see ``EvidenceParams``), though
+  not walls smeared by odometry drift.
+- A point the robot went for once and reached is ``spent`` (:meth:`ModeSwitch.spend`): it can no
+  longer attract, so a point whose surroundings cannot be explored (under a desk, behind glass)
+  does not hold the robot forever. Spent points do not count for "a point has d > K" either.
+- Selection on a map with no explored free cell raises: mark the robot's footprint first
+  (:func:`maps.exploration.mark_traversed`), otherwise the first call would be "done".
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from enum import StrEnum
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from maps.exploration import Cell, ExplorationMap, TravelCost, borders, travel_cost
+
+
+class Mode(StrEnum):
+    """What goal selection is doing."""
+
+    ATTRACTION = "attraction"  # going for the point with the highest attractive power (eq. 1)
+    FRONTIER = "frontier"  # no point has d > K: the closest reachable border point
+    DONE = "done"  # no border is reachable
+
+
+@dataclass(frozen=True, slots=True)
+class GoalParams:
+    """Parameters of goal selection."""
+
+    eta: float = 0.25  # weight of the travel cost in eq. 1, in [0, 0.5]
+    k: float = 1.0  # m: a point must lie farther than this beyond the border to attract
+    robot_radius: float = 0.26  # m: clearance the path keeps from obstacle cells
+    min_frontier: float = 0.3  # m: shorter border pieces are ignored
+    margin: float = 0.0  # m: steps with less clearance than robot_radius + margin cost more...
+    penalty: float = 0.0  # ...up to (1 + penalty) times their length (see maps.exploration.travel_cost)
+    patience: int = 1  # selections in a row without a reachable border before DONE (1: the paper)
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.eta <= 0.5:
+            raise ValueError(f"eta must be in [0, 0.5] (eq. 1), got {self.eta}")
+        if min(self.k, self.robot_radius, self.min_frontier, self.margin, self.penalty) < 0.0:
+            raise ValueError("k, robot_radius, min_frontier, margin and penalty must not be negative")
+        if self.patience < 1:
+            raise ValueError(f"patience must be at least 1, got {self.patience}")
+
+
+@dataclass(frozen=True, slots=True)
+class ModeSwitch:
+    """The mode of goal selection and the points already spent: a pure state machine.
+
+    ATTRACTION <-> FRONTIER on whether some point has d > K; any mode -> DONE when no border has
+    been reachable ``patience`` times in a row (``strikes`` counts them; the mode stays as it
+    was meanwhile); DONE stays.
+    """
+
+    mode: Mode = Mode.ATTRACTION
+    spent: frozenset[int] = field(default_factory=frozenset)
+    strikes: int = 0
+
+    def next(self, *, point_beyond_k: bool, border_reachable: bool, patience: int = 1) -> ModeSwitch:
+        """The mode after seeing the current evidence."""
+        if self.mode is Mode.DONE:
+            return self
+        if not border_reachable:
+            strikes = self.strikes + 1
+            return replace(self, mode=Mode.DONE if strikes >= patience else self.mode, strikes=strikes)
+        return replace(self, mode=Mode.ATTRACTION if point_beyond_k else Mode.FRONTIER, strikes=0)
+
+    def spend(self, point: int | None) -> ModeSwitch:
+        """This switch with ``point`` (an index into the map's points) no longer attracting."""
+        return self if point is None else replace(self, spent=self.spent | {int(point)})
+
+
+@dataclass(frozen=True, slots=True)
+class Goal:
+    """A goal: drive along ``path`` to ``target`` (the border point P_b).
+
+    ``point`` is the index of P_p in the map's points (None in frontier mode); ``distance`` is
+    d(P_p, P_b) (0 in frontier mode), ``cost`` G(v_S, P_b) and ``power`` A_P (NaN in frontier mode).
+    """
+
+    mode: Mode
+    target: tuple[float, float]
+    point: int | None
+    distance: float
+    cost: float
+    power: float
+    path: np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
+class Candidates:
+    """Everything one selection looked at (for the rerun view and for tests).
+
+    ``border`` (B x 2) reachable border points and their travel cost ``border_cost`` (B,);
+    per map point: ``distance`` d to its nearest reachable border point ``nearest`` (index into
+    ``border``, -1 without any) and the attractive power ``power`` (eq. 1; -inf without a border).
+    """
+
+    border: np.ndarray
+    border_cost: np.ndarray
+    distance: np.ndarray
+    nearest: np.ndarray
+    power: np.ndarray
+    travel: TravelCost
+
+
+def attractive_power(distance: np.ndarray, cost: np.ndarray, eta: float) -> np.ndarray:
+    """A_P = d(P_p, P_b) - eta * G(v_S, P_b) (eq. 1)."""
+    return np.asarray(distance, dtype=np.float64) - eta * np.asarray(cost, dtype=np.float64)  # eq. 1
+
+
+def candidates(m: ExplorationMap, robot: tuple[float, float], params: GoalParams = GoalParams()) -> Candidates:
+    """Reachable border points, and d, P_b and A_P (eq. 1) of every map point, seen from ``robot``."""
+    travel = travel_cost(m, robot, params.robot_radius, margin=params.margin, penalty=params.penalty)
+    min_cells = max(1, int(math.ceil(params.min_frontier / m.frame.resolution)))
+    rows, cols = np.nonzero(borders(m, min_cells) & np.isfinite(travel.cost))
+    border = m.frame.centre_of(rows, cols)
+    border_cost = travel.cost[rows, cols]
+    n = len(m.points)
+    if len(border) == 0:
+        return Candidates(border, border_cost, np.full(n, np.inf), np.full(n, -1), np.full(n, -np.inf), travel)
+    distance, nearest = cKDTree(border).query(m.points[:, :2]) if n else (np.zeros(0), np.zeros(0, dtype=np.int64))
+    distance = np.where(m.cell_state(m.points[:, :2]) == Cell.UNKNOWN, distance, 0.0)
+    power = attractive_power(distance, border_cost[nearest], params.eta)
+    return Candidates(border, border_cost, distance, np.asarray(nearest, dtype=np.int64), power, travel)
+
+
+def select_goal(
+    switch: ModeSwitch, m: ExplorationMap, robot: tuple[float, float], params: GoalParams = GoalParams()
+) -> tuple[ModeSwitch, Goal | None]:
+    """The next mode and goal for a robot at ``robot`` (odometry x, y).
+
+    No goal: DONE, or (with ``patience`` > 1) no border reachable yet again: look around, retry.
+    """
+    if not np.any(m.cells == Cell.FREE):
+        raise ValueError("the exploration map has no explored free cell: mark the robot's footprint first")
+    if switch.mode is Mode.DONE:
+        return switch, None
+    found = candidates(m, robot, params)
+    eligible = found.distance > params.k
+    if switch.spent:
+        eligible[np.fromiter(switch.spent, dtype=np.int64)] = False
+    reachable = len(found.border) > 0
+    switch = switch.next(point_beyond_k=bool(eligible.any()), border_reachable=reachable, patience=params.patience)
+    if switch.mode is Mode.DONE or not reachable:
+        return switch, None
+    if switch.mode is Mode.ATTRACTION:
+        point = int(np.argmax(np.where(eligible, found.power, -np.inf)))
+        b = int(found.nearest[point])
+        distance, power = float(found.distance[point]), float(found.power[point])
+    else:
+        point, b = None, int(np.argmin(found.border_cost))
+        distance, power = 0.0, math.nan
+    target = (float(found.border[b, 0]), float(found.border[b, 1]))
+    goal = Goal(switch.mode, target, point, distance, float(found.border_cost[b]), power, found.travel.path_to(target))
+    return switch, goal

@@ -1,0 +1,131 @@
+"""Goal selection: attractive power (eq. 1) by hand, frontier mode switching, done."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from maps.exploration import Cell, ExplorationMap, GridFrame
+from maps.exploration_goal import GoalParams, Mode, ModeSwitch, attractive_power, candidates, select_goal
+
+NO_RADIUS = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1)
+ROBOT = (0.25, 0.55)  # the centre of cell (row 5, col 2)
+
+
+def explored_strip(points: list[list[float]], *, walled: bool = False) -> ExplorationMap:
+    """Explored free floor [0, 2] x [0, 1] in 0.1 m cells (grid rows 1-10, columns 1-20) amid
+    unknown cells; ``walled``: a ring of obstacle cells around it."""
+    cells = np.zeros((31, 41), dtype=np.uint8)
+    cells[1:11, 1:21] = Cell.FREE
+    if walled:
+        cells[[0, 11], 0:22] = Cell.OBSTACLE
+        cells[0:12, [0, 21]] = Cell.OBSTACLE
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    return ExplorationMap.from_cells(GridFrame(-0.1, -0.1, 0.1, 31, 41), cells, points=pts)
+
+
+P1 = [4.0, 0.55, 0.5]  # east: nearest border (1.95, 0.55), d = 2.05, G = 17 cells = 1.7
+P2 = [0.25, 2.5, 0.5]  # north: nearest border (0.25, 0.95), d = 1.55, G = 4 cells = 0.4
+
+
+def test_eq1_attractive_power():
+    assert attractive_power(3.0, 4.0, 0.5) == pytest.approx(1.0)
+    assert attractive_power(np.array([2.05, 1.55]), np.array([1.7, 0.4]), 0.25) == pytest.approx([1.625, 1.45])
+
+
+def test_eta_outside_the_papers_range_is_refused():
+    with pytest.raises(ValueError, match="eta"):
+        GoalParams(eta=0.6)
+
+
+def test_candidates_by_hand():
+    found = candidates(explored_strip([P1, P2]), ROBOT, NO_RADIUS)
+    assert found.distance == pytest.approx([2.05, 1.55])
+    assert found.border[found.nearest] == pytest.approx(np.array([[1.95, 0.55], [0.25, 0.95]]))
+    assert found.border_cost[found.nearest] == pytest.approx([1.7, 0.4])
+    assert found.power == pytest.approx([2.05 - 0.25 * 1.7, 1.55 - 0.25 * 0.4])
+
+
+def test_the_highest_attractive_power_wins_and_eta_trades_distance_for_travel():
+    switch, goal = select_goal(ModeSwitch(), explored_strip([P1, P2]), ROBOT, NO_RADIUS)
+    assert switch.mode is Mode.ATTRACTION and goal is not None
+    assert goal.point == 0 and goal.target == pytest.approx((1.95, 0.55))
+    assert (goal.distance, goal.cost, goal.power) == pytest.approx((2.05, 1.7, 1.625))
+    assert goal.path[0] == pytest.approx(ROBOT) and goal.path[-1] == pytest.approx(goal.target)
+    # eta = 0.5: P1 2.05 - 0.85 = 1.2 < P2 1.55 - 0.2 = 1.35
+    _, goal = select_goal(ModeSwitch(), explored_strip([P1, P2]), ROBOT, GoalParams(0.5, 1.0, 0.0, 0.1))
+    assert goal is not None and goal.point == 1 and goal.target == pytest.approx((0.25, 0.95))
+
+
+def test_points_inside_the_explored_area_do_not_attract():
+    switch, goal = select_goal(ModeSwitch(), explored_strip([[1.0, 0.5, 0.3], [1.5, 1.5, 0.3]]), ROBOT, NO_RADIUS)
+    # the first is on explored floor (d = 0), the second 0.55 m beyond the border (< K)
+    assert switch.mode is Mode.FRONTIER and goal is not None and goal.point is None
+    assert goal.target == pytest.approx((0.05, 0.55)) and goal.cost == pytest.approx(0.2)  # the closest border
+    assert math.isnan(goal.power)
+
+
+def test_frontier_mode_and_back():
+    switch, _ = select_goal(ModeSwitch(), explored_strip([]), ROBOT, NO_RADIUS)
+    assert switch.mode is Mode.FRONTIER
+    switch, goal = select_goal(switch, explored_strip([P2]), ROBOT, NO_RADIUS)
+    assert switch.mode is Mode.ATTRACTION and goal is not None and goal.point == 0
+
+
+def test_a_spent_point_no_longer_attracts():
+    m = explored_strip([P1, P2])
+    switch = ModeSwitch().spend(0)
+    switch, goal = select_goal(switch, m, ROBOT, NO_RADIUS)
+    assert goal is not None and goal.point == 1
+    switch, goal = select_goal(switch.spend(1), m, ROBOT, NO_RADIUS)
+    assert switch.mode is Mode.FRONTIER and goal is not None
+
+
+def test_done_when_no_border_is_reachable_and_done_stays():
+    switch, goal = select_goal(ModeSwitch(), explored_strip([P1], walled=True), ROBOT, NO_RADIUS)
+    assert switch.mode is Mode.DONE and goal is None
+    switch, goal = select_goal(switch, explored_strip([P1, P2]), ROBOT, NO_RADIUS)
+    assert switch.mode is Mode.DONE and goal is None
+
+
+def test_borders_beyond_a_gap_the_robot_cannot_pass_do_not_count():
+    m = explored_strip([P1], walled=True)
+    cells = m.cells.copy()
+    cells[6, 21:23] = Cell.FREE  # a 0.1 m slot in the east wall at y = 0.55, explored floor behind it
+    m = ExplorationMap.from_cells(m.frame, cells, points=m.points)
+    switch, goal = select_goal(ModeSwitch(), m, ROBOT, NO_RADIUS)  # a point robot fits through
+    assert switch.mode is Mode.ATTRACTION and goal is not None and goal.target == pytest.approx((2.15, 0.55))
+    wide = GoalParams(eta=0.25, k=1.0, robot_radius=0.1, min_frontier=0.1)
+    assert select_goal(ModeSwitch(), m, ROBOT, wide)[0].mode is Mode.DONE
+
+
+def test_mode_switch_transitions():
+    a, f, d = ModeSwitch(Mode.ATTRACTION), ModeSwitch(Mode.FRONTIER), ModeSwitch(Mode.DONE)
+    assert a.next(point_beyond_k=False, border_reachable=True).mode is Mode.FRONTIER
+    assert a.next(point_beyond_k=True, border_reachable=True).mode is Mode.ATTRACTION
+    assert f.next(point_beyond_k=True, border_reachable=True).mode is Mode.ATTRACTION
+    assert f.next(point_beyond_k=False, border_reachable=True).mode is Mode.FRONTIER
+    for s in (a, f, d):
+        assert s.next(point_beyond_k=True, border_reachable=False).mode is Mode.DONE
+    assert d.next(point_beyond_k=True, border_reachable=True).mode is Mode.DONE
+    # patience: DONE only after that many selections in a row without a reachable border
+    once = f.next(point_beyond_k=False, border_reachable=False, patience=2)
+    assert (once.mode, once.strikes) == (Mode.FRONTIER, 1)
+    assert once.next(point_beyond_k=False, border_reachable=True, patience=2).strikes == 0
+    assert once.next(point_beyond_k=False, border_reachable=False, patience=2).mode is Mode.DONE
+
+
+def test_patience_gives_no_goal_before_done():
+    walled = explored_strip([P1], walled=True)
+    params = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, patience=2)
+    switch, goal = select_goal(ModeSwitch(), walled, ROBOT, params)
+    assert switch.mode is Mode.ATTRACTION and goal is None  # look around, then ask again
+    switch, goal = select_goal(switch, walled, ROBOT, params)
+    assert switch.mode is Mode.DONE and goal is None
+
+
+def test_selection_needs_the_robots_footprint_first():
+    with pytest.raises(ValueError, match="footprint"):
+        select_goal(ModeSwitch(), ExplorationMap.empty(resolution=0.1, half_size=1.0), (0.0, 0.0))

@@ -1,0 +1,182 @@
+"""Episodes that crash, kill their own process or hang are one failed row each, with the reason; the
+others finish. Ctrl-C (and SIGTERM) keep the finished rows, kill the running episodes, and --resume
+runs the rest. Both ways of starting an episode's process are covered."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from missions.cli import main
+
+TRAP_PLUGIN = """
+import os
+import signal
+import time
+
+from py_trees.common import Status
+from behaviours.base import BearingsBehaviour
+from behaviours.ports import InputPort
+from behaviours.registry import register
+
+
+@register
+class Trap(BearingsBehaviour):
+    '''On its third tick: nothing, kill its own process, exit without a report, or hang (a test plugin).'''
+    PORTS = (InputPort("action", str, "none", choices=("none", "kill", "exit", "hang"), doc="what to do"),)
+
+    def initialise(self):
+        self.ticks = 0
+
+    def update(self):
+        self.ticks += 1
+        if self.ticks < 3:
+            return Status.RUNNING
+        action = self.get_input("action")
+        if action == "kill":
+            os.kill(os.getpid(), signal.SIGKILL)
+        elif action == "exit":
+            os._exit(3)
+        elif action == "hang":
+            with open(os.path.join(os.path.dirname(__file__), f"hanging-{os.getpid()}"), "w"):
+                pass  # the test checks that this process is gone after the sweep
+            while True:
+                time.sleep(3600)
+        return Status.SUCCESS
+"""
+
+TRAP_MISSION = """
+mission: trap
+inputs:
+  action: {type: str, default: none}
+plugins: [./trap.py]
+cameras: []
+max_time: 20
+tree:
+  Sequence:
+    children:
+      - Drive: {distance: 0.05, speed: 0.5}
+      - Trap: {action: "${action}"}
+"""
+
+
+@pytest.fixture
+def trap(tmp_path: Path) -> Path:
+    (tmp_path / "trap.py").write_text(TRAP_PLUGIN)
+    mission = tmp_path / "trap.yaml"
+    mission.write_text(textwrap.dedent(TRAP_MISSION).lstrip())
+    return mission
+
+
+def rows_of(folder: Path) -> list[dict]:
+    return [json.loads(line) for line in (folder / "results.jsonl").read_text().splitlines()]
+
+
+def hanging_episodes(folder: Path) -> list[int]:
+    """Ids of the episode processes that started to hang (the plugin leaves a file each)."""
+    return [int(p.name.split("-")[1]) for p in folder.glob("hanging-*")]
+
+
+def descendants(root: int) -> set[int]:
+    """Every live process under ``root`` (its pool workers, their episode servers, episodes)."""
+    parents = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                parents[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+            except OSError:
+                continue
+    found, frontier = set(), {root}
+    while frontier:
+        frontier = {pid for pid, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
+def alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.parametrize(("start_method", "seeds", "timeout"), [("fork", [0, 1], 1.5), ("spawn", [0], 3)])
+def test_killed_crashed_and_hung_episodes_are_failed_rows(trap, tmp_path, capsys, start_method, seeds, timeout):
+    out = tmp_path / "out"  # a spawned episode's time includes starting Python and importing the stack
+    code = main(["sweep", str(trap), "--set", "action=none,kill,exit,hang", "--seeds", f"0-{len(seeds) - 1}",
+                 "--timeout", str(timeout), "--workers", "2", "--start-method", start_method, "-o", str(out)])
+    assert code == 0  # every episode has its row
+    rows = {(r["inputs.action"], r["seed"]): r for r in rows_of(out)}
+    assert len(rows) == 4 * len(seeds)
+    for seed in seeds:
+        assert rows["none", seed]["status"] == "SUCCESS"
+        assert (rows["kill", seed]["status"], rows["kill", seed]["reason"]) == ("ERROR", "killed by SIGKILL")
+        assert rows["kill", seed]["exit_code"] == -signal.SIGKILL
+        assert rows["exit", seed]["status"] == "ERROR"
+        assert rows["exit", seed]["reason"].startswith("exited with code 3 without a report")
+        assert rows["hang", seed]["status"] == "ERROR"
+        assert rows["hang", seed]["reason"] == f"timed out after {timeout:g} s wall time (episode killed)"
+        assert timeout <= rows["hang", seed]["elapsed_s"] < timeout + 3
+    failed = [r for r in rows.values() if r["status"] == "ERROR"]
+    assert all((out / "logs" / f"{r['id']}.log").is_file() for r in failed)
+    assert len(list((out / "reports").iterdir())) == len(seeds)  # only the episodes that reported
+    summary = {line.split()[0]: line.split()[1:5] for line in capsys.readouterr().out.splitlines()[1:5]}
+    n = str(len(seeds))
+    assert summary == {"exit": [n, "0%", "0", n], "hang": [n, "0%", "0", n], "kill": [n, "0%", "0", n],
+                       "none": [n, "100%", "0", "0"]}
+    hung = hanging_episodes(trap.parent)
+    assert len(hung) == len(seeds) and not any(alive(pid) for pid in hung)
+
+
+def test_ctrl_c_keeps_finished_rows_kills_running_episodes_and_resume_runs_the_rest(trap, tmp_path):
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "missions.cli", "sweep", str(trap), "--set", "action=none,hang",
+               "--timeout", "60", "--workers", "2", "-o", str(out)]
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
+    sweep = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                             start_new_session=True)  # its own process group, as a terminal job
+    try:
+        deadline = time.monotonic() + 30
+        while not (out / "results.jsonl").is_file() or not (out / "results.jsonl").read_text().strip():
+            assert time.monotonic() < deadline and sweep.poll() is None, sweep.communicate()
+            time.sleep(0.05)
+        while not hanging_episodes(trap.parent):
+            assert time.monotonic() < deadline and sweep.poll() is None, sweep.communicate()
+            time.sleep(0.05)
+        hung = hanging_episodes(trap.parent)
+        assert all(alive(pid) for pid in hung)
+        started = descendants(sweep.pid)
+        assert set(hung) <= started and len(started) >= 3  # workers, their episode servers, the episode
+        os.killpg(sweep.pid, signal.SIGINT)  # Ctrl-C reaches the whole group
+        _, err = sweep.communicate(timeout=20)
+    finally:
+        if sweep.poll() is None:
+            os.killpg(sweep.pid, signal.SIGKILL)
+            sweep.wait()
+    assert sweep.returncode == 1
+    assert "interrupted; 1 of 2 runs recorded" in err and "Traceback" not in err
+    assert [r["inputs.action"] for r in rows_of(out)] == ["none"]
+    deadline = time.monotonic() + 5
+    while any(alive(pid) for pid in started) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not [pid for pid in started if alive(pid)]  # the hanging episode was killed, nothing left behind
+    first = rows_of(out)[0]
+    assert main(["sweep", str(trap), "--set", "action=none,hang", "--timeout", "1", "--workers", "1",
+                 "--resume", "-o", str(out)]) == 0
+    rows = rows_of(out)
+    assert [r["inputs.action"] for r in rows] == ["hang", "none"] and rows[1] == first
+    assert rows[0]["reason"] == "timed out after 1 s wall time (episode killed)"
+    assert main(["sweep", str(trap), "--set", "action=none,hang", "--timeout", "0.5", "--workers", "1",
+                 "--resume", "--retry-errors", "-o", str(out)]) == 0
+    rows = rows_of(out)
+    assert [r["inputs.action"] for r in rows] == ["hang", "none"] and rows[1] == first
+    assert rows[0]["reason"] == "timed out after 0.5 s wall time (episode killed)"  # run again, its row replaced
