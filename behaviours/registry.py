@@ -39,7 +39,7 @@ ENTRY_POINT_GROUP = "bearings.behaviours"
 BUILTIN_MODULES = ("behaviours.control", "behaviours.composites", "behaviours.decorators", "behaviours.motion",
                    "behaviours.wait", "behaviours.conditions", "behaviours.perceive", "behaviours.landmark_tree",
                    "behaviours.teach", "behaviours.route", "behaviours.search", "behaviours.teleop",
-                   "behaviours.waypoints")
+                   "behaviours.waypoints", "behaviours.choice")
 _MARK = "__bearings_node_type__"
 
 

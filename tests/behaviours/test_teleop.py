@@ -82,3 +82,11 @@ def test_drive_waypoints_passes_every_point_and_stops_at_the_last():
     assert harness.read("/robot/command") == STOP
     with pytest.raises(ValueError, match="pairs"):
         waypoint_pairs([1.0, 2.0, 3.0])
+
+
+def test_equals_chooses_a_branch_at_load_time():
+    from behaviours.choice import Equals
+
+    assert BehaviourHarness(Equals(value="keyboard", equals="keyboard")).tick() == Status.SUCCESS
+    chosen = BehaviourHarness(Equals(value="waypoints", equals="keyboard"))
+    assert chosen.tick() == Status.FAILURE and "'waypoints' is not 'keyboard'" in chosen.behaviour.feedback_message

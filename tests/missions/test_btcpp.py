@@ -26,8 +26,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from behaviours.ports import InputPort, Key
-from behaviours.registry import Registry
+from behaviours.ports import InputPort, Key, Ref
+from behaviours.registry import NodeType, Registry
+from behaviours.sense import SENSE_NODES
 from maps.store import InputError
 from missions.btcpp import BUILTIN_NAMES, identifier_to_key, key_to_identifier, parse_comparison, script_literal
 from missions.cli import main
@@ -83,6 +84,31 @@ EVERY_NODE_TYPE = """
                       ForceSuccess:
                         child: {CheckBlackboard: {key: /robot/odometry.x, op: "<", value: 5.0}}
                 - ForceFailure: {child: Success}
+          - Sequence:
+              name: the LT-map nodes
+              children:
+                - LearnRoute:
+                    budget: 100000
+                    observation: "{/perception/panorama}"
+                    child:
+                      Selector:
+                        children:
+                          - KeyboardTeleop
+                          - Sequence:
+                              children:
+                                - Equals: {value: waypoints, equals: waypoints}
+                                - DriveWaypoints: {waypoints: [0.5, 0.0, 0.5, 0.5]}
+                - LoadMap: {path: route.ltmap}
+                - PruneMap: {fraction: 0.6}
+                - StartRoute: {direction: reverse}
+                - RecoveryNode:
+                    children:
+                      - Parallel:
+                          policy: one
+                          children:
+                            - FollowRoute: {observation: "{/perception/panorama}"}
+                            - ViewframeSwitch
+                      - SearchPattern: {observation: "{/perception/panorama}"}
           - Stop
 """
 
@@ -338,6 +364,9 @@ def _literal(port: InputPort) -> st.SearchStrategy[Any] | None:
         return texts
     if port.type is Key:
         return st.sampled_from([*FLOAT_REFS, "/robot/stalled", "/robot/odometry"])
+    if port.type == list[float]:  # waypoints: x, y pairs
+        pairs = st.lists(st.tuples(st.floats(-10, 10), st.floats(-10, 10)), min_size=1, max_size=3)
+        return pairs.map(lambda points: [v for point in points for v in point])
     if port.type is not object:
         return None  # a Pose2D, a dict of frames: from the blackboard only
     return st.one_of(st.integers(-(2**63), 2**63 - 1), st.floats(allow_nan=False, allow_infinity=False,
@@ -376,8 +405,17 @@ def node_bodies(draw, node_type) -> dict[str, Any]:
     return body
 
 
-LEAVES = [t for t in BUILTIN.all_types() if not t.takes_children]
-DECORATORS = [t for t in BUILTIN.all_types() if t.kind == "decorator"]
+SENSED = {port.key for cls in SENSE_NODES for port in NodeType.of(cls).outputs}
+
+
+def _fed_by_sensing(node_type: NodeType) -> bool:
+    """Its default references read sensed keys only (a tree of it alone passes the data-flow check;
+    the route nodes also read the map and the observation, written by other nodes)."""
+    return all(not isinstance(p.default, Ref) or p.default.base in SENSED for p in node_type.inputs)
+
+
+LEAVES = [t for t in BUILTIN.all_types() if not t.takes_children and _fed_by_sensing(t)]
+DECORATORS = [t for t in BUILTIN.all_types() if t.kind == "decorator" and _fed_by_sensing(t)]
 COMPOSITES = [t for t in BUILTIN.all_types() if t.kind == "composite"]
 
 
