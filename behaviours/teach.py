@@ -19,75 +19,21 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 import py_trees
-from py_trees.common import Access, Status
+from py_trees.common import Status
 
-from behaviours.base import NotSetUp, bind_ports, read_keys
-from behaviours.clock import Clock
+from behaviours.base import BearingsDecorator
 from behaviours.landmark_tree import LTMAP_OUT, save_map, summary_section
 from behaviours.motion import ODOMETRY
-from behaviours.ports import InputPort, OutputPort, Port, Ref, matches_type, type_name
-from behaviours.registry import Declared, Kind, register
+from behaviours.ports import InputPort, Port, Ref
+from behaviours.registry import register
 from maps.ltmap import DEFAULT_MIN_LANDMARKS, DEFAULT_THRESHOLD, LearnConfig, LearnStep, RouteLearner
 from maps.store import InputError
 from perception.geometry import Pose2D
 from perception.observation import Observation
 
-_UNSET: Any = object()
-
-
-class PortedDecorator(Declared, py_trees.decorators.Decorator):
-    """A decorator with declared ports: the leaf behaviours' port access, around one child.
-
-    Built as the loader builds decorators (``cls(name=..., child=..., **ports)``); its blackboard
-    client gets read access to the inputs' keys and write access to the outputs', as a leaf's.
-    """
-
-    KIND: ClassVar[Kind] = "decorator"
-    CHILDREN: ClassVar[tuple[int, int | None]] = (1, 1)
-
-    def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
-        super().__init__(name=name, child=child)
-        self.inputs, self.outputs = bind_ports(type(self).__name__, self.PORTS, ports)
-        self.bb = self.attach_blackboard_client(name=self.name)
-        for key in read_keys(self.PORTS, self.inputs):
-            self.bb.register_key(key=key, access=Access.READ)
-        for key in self.outputs.values():
-            self.bb.register_key(key=key, access=Access.WRITE)
-        self._clock: Clock | None = None
-        self._output_types = {p.name: p.type for p in self.PORTS if isinstance(p, OutputPort)}
-
-    def setup(self, **kwargs: Any) -> None:
-        """Receive the clock (and anything else the runner hands the tree)."""
-        self._clock = kwargs.get("clock", self._clock)
-
-    def now(self) -> float:
-        if self._clock is None:
-            raise NotSetUp(f"{self.name}: no clock; set the tree up with setup(clock=...)")
-        return float(self._clock.now())
-
-    def get_input(self, port: str, default: Any = _UNSET) -> Any:
-        """An input's value now: the literal, or the referenced blackboard value (as a leaf's)."""
-        value = self.inputs[port]
-        if not isinstance(value, Ref):
-            return value
-        try:
-            return self.bb.get(value.key)
-        except KeyError:
-            if default is _UNSET:
-                raise KeyError(f"{self.name}: input {port!r} reads {value}, which is not set yet") from None
-            return default
-
-    def set_output(self, port: str, value: Any) -> None:
-        """Write an output port's key, type-checked as a leaf's."""
-        expected = self._output_types[port]
-        if not matches_type(value, expected):
-            raise TypeError(f"{self.name}: output {port!r} is declared {type_name(expected)}, "
-                            f"got {type(value).__name__}")
-        self.bb.set(self.outputs[port], value, overwrite=True)
-
 
 @register
-class LearnRoute(PortedDecorator):
+class LearnRoute(BearingsDecorator):
     """Record an LT-map while the child drives; save it atomically when the child succeeds.
 
     RUNNING while the child runs; SUCCESS once the finished map is saved; FAILURE when the

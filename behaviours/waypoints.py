@@ -13,7 +13,7 @@ from typing import Any
 
 from py_trees.common import Status
 
-from behaviours.motion import ANGULAR_DECEL, LINEAR_DECEL, MIN_SPEED, MOTION_PORTS, DriveTo, _OdometryMotion, ramp
+from behaviours.motion import ANGULAR_DECEL, LINEAR_DECEL, MIN_SPEED, MOTION_PORTS, DriveTo, OdometryMotion, ramp
 from behaviours.ports import InputPort
 from behaviours.registry import register
 from perception.geometry import Pose2D, wrap_angle
@@ -27,7 +27,7 @@ def waypoint_pairs(flat: list[float]) -> list[tuple[float, float]]:
 
 
 @register
-class DriveWaypoints(_OdometryMotion):
+class DriveWaypoints(OdometryMotion):
     """Drive through the waypoints in order (odometry frame); SUCCESS at the last one.
 
     The intermediate waypoints are passed within ``tolerance`` without stopping when the next
