@@ -365,7 +365,8 @@ def _literal(port: InputPort) -> st.SearchStrategy[Any] | None:
     if port.type is Key:
         return st.sampled_from([*FLOAT_REFS, "/robot/stalled", "/robot/odometry"])
     if port.type == list[float]:  # waypoints: x, y pairs
-        pairs = st.lists(st.tuples(st.floats(-10, 10), st.floats(-10, 10)), min_size=1, max_size=3)
+        coordinate = st.floats(-10, 10, allow_subnormal=False)  # std::stod refuses subnormals
+        pairs = st.lists(st.tuples(coordinate, coordinate), min_size=1, max_size=3)
         return pairs.map(lambda points: [v for point in points for v in point])
     if port.type is not object:
         return None  # a Pose2D, a dict of frames: from the blackboard only
