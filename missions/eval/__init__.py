@@ -25,6 +25,7 @@ from typing import TextIO
 
 AREAS = {
     "exploration": "missions.eval.exploration",
+    "ltmap": "missions.eval.ltmap",
 }
 
 
