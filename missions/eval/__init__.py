@@ -24,7 +24,6 @@ from pathlib import Path
 from typing import TextIO
 
 AREAS = {
-    "exploration": "missions.eval.exploration",
     "ltmap": "missions.eval.ltmap",
 }
 
