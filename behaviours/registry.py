@@ -37,7 +37,9 @@ Kind = Literal["action", "condition", "decorator", "composite"]
 KINDS: tuple[Kind, ...] = ("action", "condition", "decorator", "composite")
 ENTRY_POINT_GROUP = "bearings.behaviours"
 BUILTIN_MODULES = ("behaviours.control", "behaviours.composites", "behaviours.decorators", "behaviours.motion",
-                   "behaviours.wait", "behaviours.conditions", "behaviours.perceive")
+                   "behaviours.wait", "behaviours.conditions", "behaviours.perceive",
+                   *(f"behaviours.roadmap.{m}" for m in ("targets", "room", "coverage", "travel", "scan", "homing",
+                                                          "graph", "navigate")))
 _MARK = "__bearings_node_type__"
 
 
