@@ -43,7 +43,7 @@ def roadmap_section(roadmap: Roadmap) -> dict[str, Any]:
     }
 
 
-def room_section(room: RoomEstimate, points: list[int], stamp: float) -> dict[str, Any]:
+def room_section(room: RoomEstimate, points: list[int], features: list[int], stamp: float) -> dict[str, Any]:
     """The room estimate: free area, reference corner (its odometry pose and when it was taken)."""
     return {
         "free_area_m2": round(float(room.free.free.sum()) * room.free.cell ** 2, 3),
@@ -52,6 +52,7 @@ def room_section(room: RoomEstimate, points: list[int], stamp: float) -> dict[st
         "reference_odometry": pose_dict(room.reference_pose),
         "reference_stamp": stamp,
         "stereo_points": points,
+        "image_features": features,
     }
 
 

@@ -17,7 +17,12 @@ image after a step of known length". One round here:
    look again: the third image. A stall, or no match after the step, tries the other side.
 4. **Triangulate** (:func:`perception.planar.distance_from_third_image`): the two homing rays
    meet where the target image was taken. The camera pose there is that point with the mean of
-   the two estimated headings; the robot pose follows from the camera's place on the robot.
+   the two estimated headings; the robot pose follows from the camera's place on the robot. The
+   two images must agree on the target's heading within ``HEADING_AGREEMENT`` (3 deg): a view
+   dominated by one flat wall makes the planar essential matrix ambiguous, and the two estimates
+   of one such pair then disagree by 5-15 degrees (measured in a 4.5 x 3.5 m room). A triangle
+   that fails (no match after the step, no parallax, disagreement) is not driven on: the image
+   after the step starts the next triangle, on the other side.
 5. **Go**: drive there and turn to its heading. When the estimate is within ``done_distance``
    of where the robot stood when the round began, the robot was there already: homing
    succeeds, and the result is that estimated pose (in the odometry frame), not the odometry
@@ -26,8 +31,8 @@ image after a step of known length". One round here:
 
 A first image that gives the turn but no direction (no parallax left after the turn: the
 camera is within a few centimetres of the target, or along its optical axis within about 3 %
-of the scene's depth) cannot be one end of the triangle: the image after the sidestep becomes
-the first one of a new triangle. More than ``max_rounds`` rounds: homing failed.
+of the scene's depth) cannot be one end of the triangle either. More than ``max_rounds``
+rounds, or more than three failed triangles: homing failed.
 
 Why the sidestep and not the step along the homing direction: a step towards the target gives
 no parallax (``distance_from_third_image`` refuses it). Why drive to the estimate rather than
@@ -62,6 +67,7 @@ from perception.planar import distance_from_third_image
 ALIGN = math.radians(20.0)  # turn towards the target's heading first beyond this
 MAX_ALIGNS = 2
 MAX_SIDESTEP_FAILURES = 3
+HEADING_AGREEMENT = math.radians(3.0)  # the two images must agree on the target's heading
 PLANNED_BEYOND = 0.5  # m: longer homing drives follow a planned path when the room is known
 
 HOMING_PORTS = (
@@ -140,8 +146,8 @@ def home(host: RoutineBehaviour, target: TargetView, settings: HomingSettings) -
             failures += 1
             if failures > MAX_SIDESTEP_FAILURES:
                 raise Failed(f"no distance to {target.name}: the third image did not match or showed no parallax")
-            if second is not None and not first.comparison.planar.ok:
-                ready = second  # no direction from the first image (no parallax yet): step again from there
+            if second is not None:
+                ready = second  # the next triangle starts from the image just taken
             side = -side
             continue
         rounds += 1
@@ -213,11 +219,12 @@ def _triangulate(first: Look, second: Look, offset: tuple[float, float]) -> tupl
     """The robot pose of the target (odometry frame) and the first camera's distance to it."""
     step, turn = optical_step(first.camera, second.camera)
     found = distance_from_third_image(first.comparison.planar, second.comparison.planar, step, turn)
-    if not found.ok:
+    headings = (first.camera.theta + first.turn, second.camera.theta + second.turn)
+    if not found.ok or abs(wrap_angle(headings[0] - headings[1])) > HEADING_AGREEMENT:
         return None
     b, d = first.bearing, found.from_first
     there = first.camera.compose(Pose2D(d * math.cos(b), d * math.sin(b), 0.0))
-    heading = mean_angle(first.camera.theta + first.turn, second.camera.theta + second.turn)
+    heading = mean_angle(*headings)
     return robot_pose(Pose2D(there.x, there.y, heading), offset), d
 
 

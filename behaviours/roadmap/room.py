@@ -94,6 +94,7 @@ class RoomEstimationDodecagon(RoutineBehaviour):
                 raise ValueError(f"{type(self).__name__}.{port} takes [x, y], got {self.inputs[port]}")
         self.display = RoadmapDisplay()
         self._points: list[int] = []
+        self._features: list[int] = []
 
     def mount(self) -> RigMount:
         axis, offset = self.inputs["pan_axis"], self.inputs["rig_offset"]
@@ -103,7 +104,7 @@ class RoomEstimationDodecagon(RoutineBehaviour):
         stereo, camera = self.get_input("stereo_camera"), self.get_input("camera")
         views: list[StereoView] = []
         images: list[TargetView] = []
-        self._points = []
+        self._points, self._features = [], []
         for corner in range(CORNERS):
             if corner:  # paper: take the pair, turn 30 degrees, drive to the next corner
                 yield from self.rotate(2.0 * math.pi / CORNERS, f"turning at corner {corner}")
@@ -115,6 +116,7 @@ class RoomEstimationDodecagon(RoutineBehaviour):
             images.append(TargetView(REFERENCE_NAME, frames[camera].image, features, frames[camera].camera,
                                      f"camera:{camera}", frames[camera].stamp))
             self._points.append(len(points))
+            self._features.append(len(features))
             self.feedback_message = f"corner {corner + 1}: {len(points)} stereo points, {len(features)} features"
             yield  # one corner's image work per tick
         params = RoomParams(support=int(self.get_input("support")),
@@ -134,7 +136,7 @@ class RoomEstimationDodecagon(RoutineBehaviour):
         if room is None:
             return {}
         stamp = reference.stamp if reference is not None else math.nan
-        return {"roadmap": {"room": room_section(room, self._points, stamp)}}
+        return {"roadmap": {"room": room_section(room, self._points, self._features, stamp)}}
 
     def log_rerun(self, rec: Any) -> None:
         room = self._read(self.output_key("room"))

@@ -17,6 +17,7 @@ stops the running motion node (its ``terminate`` commands a stop).
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Generator
 from typing import Any, ClassVar, TypeAlias, TypeVar
@@ -39,6 +40,8 @@ HEAD_TIMEOUT = 10.0  # s to level the pan-tilt head
 HEAD_TOLERANCE = math.radians(0.5)
 HEAD_SPEED = 2.0  # rad/s
 MIN_TURN = math.radians(0.3)  # smaller turns are not worth a motion
+MOTION_SLACK = 3.0  # a motion may take this many times its duration at top speed ...
+MOTION_MARGIN = 5.0  # ... plus this (s: accelerating, ramping down) before it counts as stuck
 
 
 class Failed(Exception):
@@ -110,10 +113,13 @@ class RoutineBehaviour(BearingsBehaviour):
             self.set_output("command", STOP)
 
     # -- motion through the motion nodes ---------------------------------------------------------
-    def run_motion(self, node: BearingsBehaviour, what: str) -> Step[None]:
-        """Tick a motion node once per tick until it finishes; its failure (a stall) is :class:`Failed`."""
+    def run_motion(self, node: BearingsBehaviour, what: str, expected: float) -> Step[None]:
+        """Tick a motion node once per tick until it finishes; its failure (a stall) is :class:`Failed`,
+        and so is taking more than ``MOTION_SLACK`` times the ``expected`` duration (s) plus
+        ``MOTION_MARGIN`` (a robot pushing against something it does not feel)."""
         node.setup(clock=self.clock)
         self._motion = node
+        deadline = self.now() + MOTION_SLACK * expected + MOTION_MARGIN
         try:
             while True:
                 node.tick_once()
@@ -121,12 +127,15 @@ class RoutineBehaviour(BearingsBehaviour):
                     return
                 if node.status == Status.FAILURE:
                     raise Failed(f"{what}: {node.feedback_message or 'failed'}")
+                if self.now() > deadline:
+                    raise Failed(f"{what}: no progress ({node.feedback_message})")
                 self.feedback_message = f"{what}: {node.feedback_message}"
                 yield
         finally:
             if node.status == Status.RUNNING:
                 node.stop(Status.INVALID)  # its terminate commands a stop
-            node.bb.unregister(clear=False)
+            with contextlib.suppress(KeyError):  # the blackboard was cleared under a generator closed late
+                node.bb.unregister(clear=False)
             self._motion = None
 
     def _bound(self) -> dict[str, Any]:
@@ -141,9 +150,9 @@ class RoutineBehaviour(BearingsBehaviour):
         if abs(angle) < MIN_TURN:
             return
         bound = {**self._bound(), "stalled": False}
-        node = Rotate(name=f"{self.name}: {what}", angle=math.degrees(angle), speed=self.get_input("turn_speed"),
-                      tolerance=0.5, **bound)
-        yield from self.run_motion(node, what)
+        rate = float(self.get_input("turn_speed"))
+        node = Rotate(name=f"{self.name}: {what}", angle=math.degrees(angle), speed=rate, tolerance=0.5, **bound)
+        yield from self.run_motion(node, what, abs(math.degrees(angle)) / rate)
 
     def turn_to(self, heading: float, what: str = "turning") -> Step[None]:
         """Turn to an odometry heading (rad)."""
@@ -160,8 +169,9 @@ class RoutineBehaviour(BearingsBehaviour):
         else:
             yield from self._clear_stall()
             self._last_direction = math.copysign(1.0, distance)
-        node = Drive(name=f"{self.name}: {what}", distance=distance, speed=self.get_input("speed"), **bound)
-        yield from self.run_motion(node, what)
+        speed = float(self.get_input("speed"))
+        node = Drive(name=f"{self.name}: {what}", distance=distance, speed=speed, **bound)
+        yield from self.run_motion(node, what, abs(distance) / speed)
 
     def drive_to(self, x: float, y: float, what: str = "driving", tolerance: float = 0.02) -> Step[None]:
         """Drive to the odometry point (x, y) with :class:`~behaviours.motion.DriveTo`."""
@@ -170,9 +180,11 @@ class RoutineBehaviour(BearingsBehaviour):
             return
         yield from self._clear_stall()
         self._last_direction = 1.0
-        node = DriveTo(name=f"{self.name}: {what}", x=x, y=y, speed=self.get_input("speed"), tolerance=tolerance,
-                       **self._bound())
-        yield from self.run_motion(node, what)
+        speed = float(self.get_input("speed"))
+        node = DriveTo(name=f"{self.name}: {what}", x=x, y=y, speed=speed, tolerance=tolerance, **self._bound())
+        turn = abs(wrap_angle(math.atan2(y - pose.y, x - pose.x) - pose.theta))
+        yield from self.run_motion(node, what, math.hypot(x - pose.x, y - pose.y) / speed
+                                   + math.degrees(turn) / float(self.get_input("turn_speed")))
 
     def go_to_pose(self, pose: Pose2D, what: str = "driving") -> Step[None]:
         """Drive to an odometry pose: to its position, then turn to its heading."""

@@ -5,6 +5,13 @@ and compares each with the target images not found yet (upright SIFT, ratio 0.65
 essential matrix: :mod:`behaviours.roadmap.vision`); it stops at the first image in which a
 target matches (the one with the most inliers when several do). ``ScanForTargets`` is that
 scan for the learning mission; ``NavigateToTarget`` reuses :func:`scan` to localise.
+
+A choice where the paper is vague: when the last sighting was from (nearly) the same position
+and that target is still not found, homing to it from there failed; coverage sends the robot
+back to the same position (its remaining headings are still uncovered), so this scan leaves
+that target out and looks for the others, and the target is sought again from elsewhere.
+Without this the search can sight, fail and return to the same target from the same place
+until its rounds run out.
 """
 
 from __future__ import annotations
@@ -65,6 +72,9 @@ def scan(host: RoutineBehaviour, candidates: Sequence[TargetView], images: int, 
     return None, poses
 
 
+AGAIN_WITHIN = 0.3  # m: a scan this close to the last sighting's skips that target if it is still not found
+
+
 @register
 class ScanForTargets(RoutineBehaviour):
     """Take 12 images turning on the spot; stop at the first that matches a target not found yet.
@@ -87,6 +97,7 @@ class ScanForTargets(RoutineBehaviour):
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
         self.scans = 0
+        self.last: tuple[str, Pose2D] | None = None  # the last sighting: target, where from (reference frame)
 
     def routine(self) -> Step[None]:
         targets: TargetImages | None = self.get_input("targets", None)
@@ -95,16 +106,23 @@ class ScanForTargets(RoutineBehaviour):
             raise Failed("no target images" if targets is None else "no room estimate")
         roadmap: Roadmap | None = self.get_input("roadmap", None)
         found = set(roadmap.names) if roadmap is not None else set()
-        candidates = [v for v in targets.views if v.name not in found]
+        here = room.to_reference((yield from self.pose()))
+        candidates = [v for v in targets.views if v.name not in found and not self._failed_here(v.name, here)]
         if not candidates:
-            raise Failed("every target is found already")
+            raise Failed("every target is found already" if not set(targets.names) - found else
+                         f"no target left to look for from ({here.x:.1f}, {here.y:.1f})")
         sighting, poses = yield from scan(self, candidates, int(self.get_input("images")),
                                           int(self.get_input("min_inliers")))
         self.scans += 1
-        here = room.to_reference(poses[0])
         headings = tuple(room.to_reference(p).theta for p in poses)
         self.set_output("scan", ScanRecord(self.scans, here.x, here.y, headings, sighting.target if sighting else ""))
         if sighting is None:
             raise Failed(f"no target in sight from ({here.x:.1f}, {here.y:.1f})")
+        self.last = (sighting.target, here)
         self.set_output("sighting", sighting)
         self.feedback_message = f"{sighting.target} in sight ({sighting.inliers} inliers)"
+
+    def _failed_here(self, name: str, here: Pose2D) -> bool:
+        """The last sighting was of this target from (nearly) here, and it is still not found: homing to it
+        from here failed, so look for the others (and for it from elsewhere)."""
+        return self.last is not None and self.last[0] == name and self.last[1].distance_to(here) < AGAIN_WITHIN
