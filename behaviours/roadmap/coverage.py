@@ -17,6 +17,9 @@ Choices where the paper is vague:
   fewer than ``min_new`` configurations (default 100: under a tenth of what a fresh position
   covers in the lab).
 - The goal's heading is the direction of travel to it, so getting there needs no final turn.
+- A goal given out and not followed by a scan (this node ticks again with no new ``scan``:
+  the travel there failed) is taken as unreachable: positions within 0.3 m of it are no longer
+  candidates. Otherwise the same best position would be chosen, and failed, round after round.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
@@ -35,6 +39,8 @@ from behaviours.roadmap.values import ScanRecord
 from maps.coverage import FRAGMENT_COST, CoverageGrid, choose_next, coverage_grid, reachable_positions
 from maps.room import RoomEstimate
 from perception.geometry import Pose2D
+
+UNREACHABLE_RADIUS = 0.3  # m around a goal the robot did not reach: not a candidate again
 
 
 @register
@@ -63,6 +69,8 @@ class CoverageScoring(BearingsBehaviour):
         super().__init__(name=name, **ports)
         self.grid: CoverageGrid | None = None
         self.applied: set[int] = set()
+        self.pending: Pose2D | None = None  # the last goal given, until a scan from it arrives
+        self.unreachable: list[Pose2D] = []
         self.choices = 0
         self.display = RoadmapDisplay()
 
@@ -78,26 +86,43 @@ class CoverageScoring(BearingsBehaviour):
         if scan is not None and scan.seq not in self.applied:
             self.applied.add(scan.seq)
             grid = grid.cover(scan.x, scan.y, scan.headings)  # the headings actually imaged
+            self.pending = None
+        if self.pending is not None:  # asked for again with no scan since: the robot did not get there
+            self.unreachable.append(self.pending)
         self.grid = grid
         self.set_output("coverage", grid)
         here = room.to_reference(odometry)
         candidates = reachable_positions(grid, room.free, radius, here.x, here.y)
-        choice = choose_next(grid, candidates=candidates if candidates.any() else grid.valid,
+        candidates = self._without_unreachable(grid, candidates if candidates.any() else grid.valid)
+        choice = choose_next(grid, candidates=candidates,
                              min_new=int(self.get_input("min_new")),
                              fragment_cost=float(self.get_input("fragment_cost")))
         if choice is None:
             self.feedback_message = f"nothing left to cover ({100 * grid.fraction_covered:.0f} % covered)"
             return Status.FAILURE
         self.choices += 1
-        self.set_output("goal", Pose2D(choice.x, choice.y, math.atan2(choice.y - here.y, choice.x - here.x)))
+        self.pending = Pose2D(choice.x, choice.y, math.atan2(choice.y - here.y, choice.x - here.x))
+        self.set_output("goal", self.pending)
         self.feedback_message = (f"position {self.choices} at ({choice.x:.1f}, {choice.y:.1f}): {choice.new} new, "
                                  f"{100 * grid.fraction_covered:.0f} % covered")
         return Status.SUCCESS
+
+    def _without_unreachable(self, grid: CoverageGrid, candidates: np.ndarray) -> np.ndarray:
+        """The candidates farther than ``UNREACHABLE_RADIUS`` from every goal the robot did not reach."""
+        if not self.unreachable:
+            return candidates
+        ix, iy = np.indices(grid.valid.shape)
+        x, y = grid.origin[0] + ix * grid.cell, grid.origin[1] + iy * grid.cell
+        keep = candidates.copy()
+        for goal in self.unreachable:
+            keep &= np.hypot(x - goal.x, y - goal.y) > UNREACHABLE_RADIUS
+        return keep
 
     def report_sections(self) -> dict[str, Any]:
         if self.grid is None:
             return {}
         return {"roadmap": {"search": {"positions_chosen": self.choices, "scans": len(self.applied),
+                                       "unreachable": len(self.unreachable),
                                        "covered_fraction": round(self.grid.fraction_covered, 4)}}}
 
     def log_rerun(self, rec: Any) -> None:

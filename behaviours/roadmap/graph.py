@@ -11,7 +11,8 @@ One pair (a, b):
 2. a -> b: drive straight to where the map puts b relative to a (``DriveTo`` then a turn: the
    rotate-drive-rotate of an edge), home to b. The odometry from the homed pose at a to the homed
    pose at b is the forward estimate;
-3. b -> a the same way: the backward estimate;
+3. b -> a: drive straight back to the odometry pose the robot left a from (the line just
+   driven, retraced: no map error this time), home to a: the backward estimate;
 4. :meth:`maps.roadmap.Roadmap.with_round_trip` fuses them (it refuses estimates that disagree
    beyond their covariances: the edge is dropped).
 
@@ -32,6 +33,10 @@ Choices where the paper is vague:
   (the simulated base under-counts turns by 2 % and distances by 1 %, with 2 % wheel slip;
   homing ends within about 1 cm and 0.6 deg). The edges are measured and replayed in odometry
   units, so a robot's systematic odometry error cancels between learning and navigation.
+- **Drift**: every homing at a target anchors the room there (the reference pose in odometry
+  becomes the homed pose composed with the inverse of the target's pose in the map), so travel
+  between pairs plans in a map that is off by the target's map error (a few centimetres), not
+  by the odometry drift of the whole graph. The anchored room is written (``room_out``).
 - **A failed pair** (homing lost, a stall, an inconsistent round trip): dropped with its reason;
   after a failure of motion the robot returns to the reference and homes to the reference image
   (the room's reference pose is re-anchored there for the rest of the graph). A pair whose first
@@ -121,6 +126,7 @@ class BuildGraph(RoutineBehaviour):
         *PLAN_PORTS,
         *ROUTINE_PORTS,
         OutputPort("roadmap_out", Roadmap, "/map/roadmap", doc="the roadmap with its edges"),
+        OutputPort("room_out", RoomEstimate, "/map/room", doc="the room, anchored where the robot last homed"),
     )
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
@@ -198,19 +204,20 @@ class BuildGraph(RoutineBehaviour):
     def _pair(self, a: str, b: str, targets: TargetImages) -> Step[bool]:
         """Measure a -> b and back; True when the first drive a -> b stalled (worth trying from b)."""
         settings = HomingSettings.of(self)
-        leg = "reaching"
+        assert self.graph is not None
+        graph, leg = self.graph, "reaching"
         try:
             start = yield from self._reach(a, targets.get(a), settings)
             leg = "out"
-            there = yield from self._edge(start, a, b, targets.get(b), settings)
+            goal = start.compose(graph.target(b).pose.relative_to(graph.target(a).pose))
+            there = yield from self._edge(goal, a, b, targets.get(b), settings)
             leg = "back"
-            back = yield from self._edge(there, b, a, targets.get(a), settings)
+            back = yield from self._edge(start, b, a, targets.get(a), settings)  # retrace the line just driven
         except Failed as exc:
             self.log.dropped.append({"from": a, "to": b, "reason": str(exc)})
             self.at = None
             yield from self._to_reference(settings)
             return leg == "out" and "stalled" in str(exc)
-        assert self.graph is not None
         try:
             self.graph = self.graph.with_round_trip(a, b, measured_motion(start, there), measured_motion(there, back))
         except InconsistentEstimates as exc:
@@ -224,26 +231,38 @@ class BuildGraph(RoutineBehaviour):
         assert self.room is not None and self.graph is not None
         yield from travel(self, self.room, self.graph.target(name).pose, turn=True)
         result = yield from home(self, view, settings)
-        self.at = (name, result.pose)
+        self._homed(name, result.pose)
         return result.pose
 
-    def _edge(self, start: Pose2D, a: str, b: str, view: TargetView, settings: HomingSettings) -> Step[Pose2D]:
-        """Drive the straight edge a -> b from the homed pose at a, home to b: the homed pose at b."""
-        assert self.graph is not None
-        goal = start.compose(self.graph.target(b).pose.relative_to(self.graph.target(a).pose))
+    def _edge(self, goal: Pose2D, a: str, b: str, view: TargetView, settings: HomingSettings) -> Step[Pose2D]:
+        """Drive straight from the homed pose at a to ``goal`` (odometry), home to b: the homed pose at b."""
         yield from self.go_to_pose(goal, f"edge {a} -> {b}")
         result = yield from home(self, view, settings)
-        self.at = (b, result.pose)
+        self._homed(b, result.pose)
         return result.pose
+
+    def _homed(self, name: str, pose: Pose2D) -> None:
+        """The robot is homed at target ``name`` (odometry ``pose``): anchor the room there (module docstring)."""
+        assert self.graph is not None and self.room is not None
+        self.at = (name, pose)
+        self._anchor(pose.compose(self.graph.target(name).pose.inverse()))
+
+    def _anchor(self, reference_pose: Pose2D) -> None:
+        assert self.room is not None
+        self.room = reanchored(self.room, reference_pose)
+        self.set_output("room_out", self.room)
 
     def _to_reference(self, settings: HomingSettings) -> Step[None]:
         assert self.room is not None
         reference: TargetView | None = self.get_input("reference", None)
         if reference is None:
             raise Failed("an edge failed and there is no reference image to return to")
-        yield from travel(self, self.room, Pose2D(), turn=True)
+        try:
+            yield from travel(self, self.room, Pose2D(), turn=True)
+        except Failed:  # ran into something on the way back (the map is off by the drift): once more
+            yield from travel(self, self.room, Pose2D(), turn=True)
         result = yield from home(self, reference, settings)
-        self.room = reanchored(self.room, result.pose)
+        self._anchor(result.pose)
 
     def _finish(self) -> None:
         assert self.graph is not None

@@ -7,9 +7,11 @@ on odometry, each waypoint converted through the room's reference pose.
 Choices where the paper is vague:
 
 - **Start or goal where the grid says the robot cannot stand** (after homing to a target close
-  to furniture; a target on the edge of the free polygon): the nearest standable point within
-  ``SNAP`` (0.6 m) is planned from or to instead, and the robot drives straight between it and
-  the real point. Farther than that: no path (the routine fails with the reason).
+  to furniture; a target on the edge of the free polygon; the map's anchor off by some drift):
+  the nearest standable point is planned from or to instead, and the robot drives straight
+  between it and the real point. A goal farther than ``SNAP`` (0.6 m) from standable floor has no
+  path (the routine fails with the reason); the start has no such limit (the robot stands on
+  free floor, whatever the map says).
 - The room's reference pose moves in the odometry frame when the robot homes to the reference
   image again (:func:`reanchored`): the map and its free grid stay as they are.
 """
@@ -17,6 +19,7 @@ Choices where the paper is vague:
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -58,7 +61,7 @@ def plan(host: RoutineBehaviour, room: RoomEstimate, goal: Pose2D) -> Step[PlanR
     """
     radius = float(host.get_input("robot_radius"))
     here = room.to_reference((yield from host.pose()))
-    start = nearest_standable(room.free, here.x, here.y, radius)
+    start = nearest_standable(room.free, here.x, here.y, radius, snap=math.inf)  # the robot is on free floor
     end = nearest_standable(room.free, goal.x, goal.y, radius)
     if start is None or end is None:
         what = "robot" if start is None else "goal"

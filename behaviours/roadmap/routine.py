@@ -174,11 +174,15 @@ class RoutineBehaviour(BearingsBehaviour):
         yield from self.run_motion(node, what, abs(distance) / speed)
 
     def drive_to(self, x: float, y: float, what: str = "driving", tolerance: float = 0.02) -> Step[None]:
-        """Drive to the odometry point (x, y) with :class:`~behaviours.motion.DriveTo`."""
+        """Drive to the odometry point (x, y): turn on the spot to face it, then
+        :class:`~behaviours.motion.DriveTo`, so the path is the straight segment a planner or an edge
+        assumes (DriveTo alone turns in place only beyond 30 degrees and arcs below that)."""
         pose = yield from self.pose()
         if math.hypot(x - pose.x, y - pose.y) <= tolerance:
             return
         yield from self._clear_stall()
+        yield from self.turn_to(math.atan2(y - pose.y, x - pose.x), what)
+        pose = yield from self.pose()
         self._last_direction = 1.0
         speed = float(self.get_input("speed"))
         node = DriveTo(name=f"{self.name}: {what}", x=x, y=y, speed=speed, tolerance=tolerance, **self._bound())

@@ -12,6 +12,11 @@ back to the same position (its remaining headings are still uncovered), so this 
 that target out and looks for the others, and the target is sought again from elsewhere.
 Without this the search can sight, fail and return to the same target from the same place
 until its rounds run out.
+
+Another: a scan that found nothing turns back to where it started (``unwind``). Odometry that
+counts turns a few percent short (2 % in the simulator, typical of a differential base) has
+then made no net error: the robot truly turned as far back as forwards. A full scan left
+wound up would leave about 7 degrees of heading error in the map's anchor, 0.35 m at 3 m.
 """
 
 from __future__ import annotations
@@ -34,6 +39,8 @@ SCAN_PORTS = (
               doc="images per position, evenly spaced over a full turn (paper: 12)"),
     InputPort("min_inliers", int, MIN_INLIERS, minimum=8, maximum=10000, literal_only=True,
               doc="correspondences agreeing on one planar motion for a match"),
+    InputPort("unwind", bool, True, literal_only=True,
+              doc="after a scan that found nothing, turn back to the first heading (no net turn)"),
 )
 
 
@@ -51,11 +58,12 @@ def best_match(host: RoutineBehaviour, candidates: Sequence[TargetView], min_inl
     return best, pose
 
 
-def scan(host: RoutineBehaviour, candidates: Sequence[TargetView], images: int, min_inliers: int
-         ) -> Step[tuple[Sighting | None, list[Pose2D]]]:
+def scan(host: RoutineBehaviour, candidates: Sequence[TargetView], images: int, min_inliers: int, *,
+         unwind: bool = False) -> Step[tuple[Sighting | None, list[Pose2D]]]:
     """Turn through ``images`` headings, stop at the first image where a candidate matches.
 
     Returns the sighting (None when nothing matched) and the odometry poses of the images taken.
+    With ``unwind``, a scan that found nothing turns back to its first heading (module docstring).
     """
     poses: list[Pose2D] = []
     for index in range(images):
@@ -69,6 +77,8 @@ def scan(host: RoutineBehaviour, candidates: Sequence[TargetView], images: int, 
             return Sighting(view.name, pose, comparison.planar.bearing, comparison.planar.theta, comparison.inliers,
                             comparison.matches), poses
         yield  # one image's work per tick
+    if unwind and len(poses) > 1:
+        yield from host.rotate(-2.0 * math.pi / images * (len(poses) - 1), "turning back to the first heading")
     return None, poses
 
 
@@ -112,7 +122,7 @@ class ScanForTargets(RoutineBehaviour):
             raise Failed("every target is found already" if not set(targets.names) - found else
                          f"no target left to look for from ({here.x:.1f}, {here.y:.1f})")
         sighting, poses = yield from scan(self, candidates, int(self.get_input("images")),
-                                          int(self.get_input("min_inliers")))
+                                          int(self.get_input("min_inliers")), unwind=bool(self.get_input("unwind")))
         self.scans += 1
         headings = tuple(room.to_reference(p).theta for p in poses)
         self.set_output("scan", ScanRecord(self.scans, here.x, here.y, headings, sighting.target if sighting else ""))
