@@ -50,7 +50,7 @@ import numpy as np
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.paths import travel
-from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.values import HomingResult, TargetImages, TargetView
 from behaviours.roadmap.vision import (
     Comparison,
@@ -80,6 +80,7 @@ HOMING_PORTS = (
     InputPort("min_inliers", int, 25, minimum=8, maximum=10000, literal_only=True,
               doc="correspondences agreeing on one planar motion for a match"),
     InputPort("room", RoomEstimate, None, doc="room estimate (optional): sidestep towards free floor first"),
+    ROBOT_RADIUS,
 )
 
 

@@ -62,8 +62,8 @@ SETTLE = InputPort("settle", float, 0.3, unit="s", minimum=0.0, maximum=5.0,
                    doc="time at rest before an image is taken")
 ROBOT_RADIUS = InputPort("robot_radius", float, 0.28, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
                          doc="radius of the disc the robot occupies (with a margin)")
-ROUTINE_PORTS: tuple[Port, ...] = (CAMERA, CAMERA_OFFSET, ROBOT_RADIUS, SPEED, TURN_SPEED, SETTLE, ODOMETRY, STALLED,
-                                   FRAMES, HEAD, COMMAND, HEAD_COMMAND)
+ROUTINE_PORTS: tuple[Port, ...] = (CAMERA, CAMERA_OFFSET, SPEED, TURN_SPEED, SETTLE, ODOMETRY, STALLED, FRAMES, HEAD,
+                                   COMMAND, HEAD_COMMAND)
 """Ports every routine has: its camera, motion limits, the robot's state and its two commands."""
 
 

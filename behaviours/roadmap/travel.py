@@ -18,7 +18,7 @@ from behaviours.registry import register
 from behaviours.roadmap.display import RoadmapDisplay
 from behaviours.roadmap.homing import HOMING_PORTS, HomingSettings, home
 from behaviours.roadmap.paths import PLAN_TIME, reanchored, travel
-from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.values import TargetView
 from maps.planning import PlanResult
 from maps.room import RoomEstimate
@@ -39,6 +39,7 @@ class GoToPose(RoutineBehaviour):
         InputPort("goal", Pose2D, Ref("/map/coverage_goal"), doc="where to go (reference frame)"),
         InputPort("turn", bool, False, literal_only=True, doc="turn to the goal's heading at the end"),
         InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate"),
+        ROBOT_RADIUS,
         *PLAN_PORTS,
         *ROUTINE_PORTS,
     )

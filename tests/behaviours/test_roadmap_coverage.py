@@ -66,3 +66,16 @@ def test_a_robot_off_the_standable_floor_still_gets_a_goal():
     harness = scoring()
     harness.write("/robot/odometry", Pose2D(0.05, 0.05, 0.0))  # in a corner, where the grid says it cannot stand
     assert harness.tick() == Status.SUCCESS
+
+
+def test_a_goal_not_followed_by_a_scan_is_not_chosen_again():
+    harness = scoring()
+    harness.tick()
+    first = harness.read("/map/coverage_goal")
+    assert harness.tick() == Status.SUCCESS  # asked again without a scan: the robot did not get there
+    second = harness.read("/map/coverage_goal")
+    assert second.distance_to(first) > 0.3
+    assert harness.behaviour.report_sections()["roadmap"]["search"]["unreachable"] == 1
+    harness.write("/map/scan", ScanRecord(1, second.x, second.y, tuple(image_headings())))
+    harness.tick()  # a scan came: the second goal was reached
+    assert harness.behaviour.report_sections()["roadmap"]["search"]["unreachable"] == 1

@@ -41,6 +41,9 @@ def test_turns_until_a_target_matches_and_stops_there():
     assert scan.found == "centre" and scan.seq == 1
     here = ROOM.to_reference(Pose2D())  # the scan record is in the reference frame
     assert (scan.x, scan.y) == pytest.approx((here.x, here.y))
+    # scanning again from here with centre still not found: homing to it from here failed, look elsewhere
+    assert harness.tick_until(between=world.step, max_ticks=10) == Status.FAILURE
+    assert harness.behaviour.feedback_message == "no target left to look for from (-0.5, 0.0)"
 
 
 def test_a_full_turn_without_a_match_fails_and_records_twelve_headings():
@@ -53,6 +56,7 @@ def test_a_full_turn_without_a_match_fails_and_records_twelve_headings():
     assert len(scan.headings) == 12 and scan.found == ""
     assert np.degrees(np.unwrap(scan.headings)[-1] - scan.headings[0]) == pytest.approx(330.0, abs=2.0)
     assert harness.read("/map/sighting") is None
+    assert abs(math.degrees(wrap_angle(world.true_pose().theta - START.theta))) < 1.0  # unwound: no net turn
 
 
 def test_targets_already_found_are_not_looked_for():
