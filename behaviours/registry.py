@@ -38,8 +38,8 @@ KINDS: tuple[Kind, ...] = ("action", "condition", "decorator", "composite")
 ENTRY_POINT_GROUP = "bearings.behaviours"
 BUILTIN_MODULES = ("behaviours.control", "behaviours.composites", "behaviours.decorators", "behaviours.motion",
                    "behaviours.wait", "behaviours.conditions", "behaviours.perceive",
-                   *(f"behaviours.roadmap.{m}" for m in ("targets", "room", "coverage", "travel", "scan", "homing",
-                                                          "graph", "navigate")))
+                   *(f"behaviours.roadmap.{m}" for m in ("targets", "calibration", "room", "coverage", "travel",
+                                                          "scan", "homing", "graph", "navigate")))
 _MARK = "__bearings_node_type__"
 
 

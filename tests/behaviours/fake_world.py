@@ -27,18 +27,20 @@ class FakeWorld:
     """Odometry, stall flag, pan-tilt state and camera frames for one behaviour under test."""
 
     def __init__(self, world: str = "lab", start: Pose2D | None = None, cameras: tuple[str, ...] = ("front",),
-                 *, pan: float = 0.0) -> None:
+                 *, pan: float = 0.0, turn_gain: float = 1.0) -> None:
         self.sim = Simulation.load(world, seed=0, noise=False)
         self.start = start if start is not None else Pose2D(2.0, 2.0, 0.0)
         self.cameras = cameras
+        self.turn_gain = turn_gain  # true turn / turn the odometry counts (1: odometry is the truth)
         self.odometry = Pose2D()
+        self.true = self.start
         self.head = PanTiltState(pan, 0.0, False)
         self.radius = self.sim.world.robot_radius
         self.contacts = 0
         self.renders = 0
 
     def true_pose(self) -> Pose2D:
-        return self.start.compose(self.odometry)
+        return self.true
 
     def blackboard(self, **extra: Any) -> dict[str, Any]:
         """The sensed keys at the start (plus ``extra``, keys with '/' written as '__')."""
@@ -59,18 +61,16 @@ class FakeWorld:
         head = harness.read("/ptu/command")
         if isinstance(head, PanTiltCommand):
             self.head = PanTiltState(head.pan, head.tilt, False)
-        pose = self.odometry
-        theta = pose.theta + command.w * dt
-        moved = Pose2D(pose.x + command.v * dt * math.cos(pose.theta), pose.y + command.v * dt * math.sin(pose.theta),
-                       wrap_angle(theta))
-        true = self.start.compose(moved)
-        here = self.true_pose()
+        pose, here = self.odometry, self.true
+        moved = _step(pose, command.v, command.w, dt)
+        true = _step(here, command.v, command.w * self.turn_gain, dt)
         clearance = self.sim.scene.clearance(true.x, true.y)  # the simulator's rule: no closer once touching
         blocked = clearance < self.radius and clearance < self.sim.scene.clearance(here.x, here.y) - 1e-12
         stalled = blocked
         if blocked:
             self.contacts += 1
-            moved = pose
+            moved, true = pose, here
+        self.true = true
         at_rest = (moved.x, moved.y, moved.theta) == (pose.x, pose.y, pose.theta)
         self.odometry = Pose2D(moved.x, moved.y, moved.theta, harness.clock.now() + dt)
         harness.write("/robot/odometry", self.odometry)
@@ -78,6 +78,11 @@ class FakeWorld:
         harness.write("/ptu/state", self.head)
         if at_rest:
             harness.write("/perception/frames", self.frames_now(harness.clock.now() + dt))
+
+
+def _step(pose: Pose2D, v: float, w: float, dt: float) -> Pose2D:
+    return Pose2D(pose.x + v * dt * math.cos(pose.theta), pose.y + v * dt * math.sin(pose.theta),
+                  wrap_angle(pose.theta + w * dt))
 
 
 def error_to(world: FakeWorld, truth: Pose2D) -> tuple[float, float]:
