@@ -29,10 +29,17 @@ Choices where the paper is vague:
   is homed at first), starting from that end, so a chain of pairs needs no travel between them.
 - **Covariance of one estimate** (over angle1, distance, angle2; independent): odometry errors
   grow with what was driven, homing adds a fixed error at each end:
-  ``sigma_angle = 0.03 |angle| + 1 deg`` and ``sigma_distance = 0.02 distance + 0.02 m``
-  (the simulated base under-counts turns by 2 % and distances by 1 %, with 2 % wheel slip;
-  homing ends within about 1 cm and 0.6 deg). The edges are measured and replayed in odometry
-  units, so a robot's systematic odometry error cancels between learning and navigation.
+  ``sigma_angle^2 = (0.01 |angle| + 0.5 deg)^2 + (0.6 deg)^2 distance[m]`` and
+  ``sigma_distance = 0.02 distance + 0.02 m``. Measured in the simulator: calibrated turns
+  (``CalibrateTurns``) leave about 0.3 deg per half turn; straight driving drifts 1 deg (one
+  sigma) in heading over 3 m; homing ends within about 1 cm, its heading estimate within about
+  0.2 deg. The edges are measured and replayed on the same (calibrated) odometry, so what is
+  left of a robot's systematic error cancels between learning and navigation.
+- **Target poses** (:mod:`maps.pose_graph`): each target's pose was measured once, by the trip
+  from it back to the reference when it was found (covariance by the same model); after every
+  new edge the targets' poses are refitted to those measurements and all the edges (weighted
+  least squares), so a far target joined to a near one is placed by both routes. The edges
+  themselves are kept as measured.
 - **Drift**: every homing at a target anchors the room there (the reference pose in odometry
   becomes the homed pose composed with the inverse of the target's pose in the map), so travel
   between pairs plans in a map that is off by the target's map error (a few centimetres), not
@@ -66,13 +73,15 @@ from behaviours.roadmap.targets import relative_images
 from behaviours.roadmap.travel import PLAN_PORTS
 from behaviours.roadmap.values import TargetImages, TargetView
 from maps.planning import segment_is_free
+from maps.pose_graph import refine_targets
 from maps.roadmap import EdgeMotion, InconsistentEstimates, Roadmap
 from maps.room import RoomEstimate
 from perception.geometry import Pose2D, wrap_angle
 
-TURN_NOISE = 0.03  # sigma per radian turned
+TURN_NOISE = 0.01  # sigma per radian turned (calibrated turns)
+DRIFT = math.radians(0.6)  # heading sigma per square-root metre driven
 DRIVE_NOISE = 0.02  # sigma per metre driven
-HOMING_HEADING = math.radians(1.0)
+HOMING_HEADING = math.radians(0.5)
 HOMING_POSITION = 0.02  # m
 END_CLEARANCE = 0.3  # m at each end of an edge not checked against the free grid
 
@@ -83,9 +92,10 @@ def measured_motion(start: Pose2D, end: Pose2D) -> EdgeMotion:
     distance = math.hypot(rel.x, rel.y)
     angle1 = math.atan2(rel.y, rel.x) if distance > 1e-9 else 0.0
     angle2 = wrap_angle(rel.theta - angle1)
-    sigmas = (TURN_NOISE * abs(angle1) + HOMING_HEADING, DRIVE_NOISE * distance + HOMING_POSITION,
-              TURN_NOISE * abs(angle2) + HOMING_HEADING)
-    return EdgeMotion(angle1, distance, angle2, np.diag(np.square(sigmas)))
+    variances = ((TURN_NOISE * abs(angle1) + HOMING_HEADING) ** 2 + DRIFT ** 2 * distance,
+                 (DRIVE_NOISE * distance + HOMING_POSITION) ** 2,
+                 (TURN_NOISE * abs(angle2) + HOMING_HEADING) ** 2 + DRIFT ** 2 * distance)
+    return EdgeMotion(angle1, distance, angle2, np.diag(variances))
 
 
 def straight_is_free(room: RoomEstimate, a: Pose2D, b: Pose2D, radius: float) -> bool:
@@ -136,6 +146,7 @@ class BuildGraph(RoutineBehaviour):
         self.graph: Roadmap | None = None
         self.room: RoomEstimate | None = None
         self.at: tuple[str, Pose2D] | None = None  # the target the robot is homed at, and its odometry pose
+        self.priors: dict[str, EdgeMotion] = {}  # each target's own measurement from the reference
 
     def routine(self) -> Step[None]:
         roadmap: Roadmap | None = self.get_input("roadmap", None)
@@ -145,6 +156,7 @@ class BuildGraph(RoutineBehaviour):
             raise Failed("no roadmap" if roadmap is None else "no target images" if targets is None
                          else "no room estimate")
         self.graph, self.log, self.at = roadmap, GraphLog(), None
+        self.priors = {t.name: measured_motion(Pose2D(), t.pose) for t in roadmap.targets}
         pairs, unknown = self._pairs(roadmap)
         while pairs:
             a, b = self._next(pairs)
@@ -222,6 +234,8 @@ class BuildGraph(RoutineBehaviour):
             self.graph = self.graph.with_round_trip(a, b, measured_motion(start, there), measured_motion(there, back))
         except InconsistentEstimates as exc:
             self.log.dropped.append({"from": a, "to": b, "reason": str(exc)})
+            return False
+        self.graph = refine_targets(self.graph, self.priors)
         return False
 
     def _reach(self, name: str, view: TargetView, settings: HomingSettings) -> Step[Pose2D]:

@@ -29,9 +29,9 @@ def test_measured_motion_and_its_covariance_by_hand():
     motion = measured_motion(Pose2D(1.0, 1.0, math.pi / 2), Pose2D(0.0, 2.0, math.pi))
     # in the start frame the end is at (1, 1) facing +90 deg: turn 45, drive sqrt(2), turn 45
     assert (motion.angle1, motion.distance, motion.angle2) == pytest.approx((math.pi / 4, math.sqrt(2), math.pi / 4))
-    turn = 0.03 * math.pi / 4 + math.radians(1.0)
+    turn = (0.01 * math.pi / 4 + math.radians(0.5)) ** 2 + math.radians(0.6) ** 2 * math.sqrt(2)
     drive = 0.02 * math.sqrt(2) + 0.02
-    assert np.diag(motion.covariance) == pytest.approx([turn ** 2, drive ** 2, turn ** 2])
+    assert np.diag(motion.covariance) == pytest.approx([turn, drive ** 2, turn])
     assert motion.covariance[0, 1] == 0.0
 
 
