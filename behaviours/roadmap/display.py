@@ -1,8 +1,9 @@
 """The ``roadmap`` report section and the rerun views of the roadmap nodes.
 
 Report (``report_sections()`` of the nodes, merged by the runner under ``roadmap``):
-``room`` (RoomEstimationDodecagon), ``targets`` and ``edges``/``connected`` (from the roadmap
-on the blackboard: RecordTarget, BuildGraph), ``search`` (CoverageScoring), ``navigation``
+``turn_scale`` (CalibrateTurns), ``room`` (RoomEstimationDodecagon), ``targets`` and
+``edges``/``connected`` (from the roadmap on the blackboard: RecordTarget, BuildGraph),
+``search`` (CoverageScoring), ``reference_drift_m (NODE)`` (ReturnToReference), ``navigation``
 (NavigateToTarget). Angles in degrees, lengths in metres, poses in the reference frame.
 
 rerun (``log_rerun(rec)``, after every recorded tick; logged again only when the value

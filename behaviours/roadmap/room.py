@@ -131,20 +131,13 @@ class RoomEstimationDodecagon(RoutineBehaviour):
                                 f"{room.reference_index + 1}"
 
     def report_sections(self) -> dict[str, Any]:
-        room = self._read(self.output_key("room"))
-        reference = self._read(self.output_key("reference"))
+        room, reference = self.written("room"), self.written("reference")
         if room is None:
             return {}
         stamp = reference.stamp if reference is not None else math.nan
         return {"roadmap": {"room": room_section(room, self._points, self._features, stamp)}}
 
     def log_rerun(self, rec: Any) -> None:
-        room = self._read(self.output_key("room"))
+        room = self.written("room")
         self.display.log_room(rec, room)
         self.display.log_robot(rec, room, self.get_input("odometry", None))
-
-    def _read(self, key: str) -> Any:
-        try:
-            return self.bb.get(key)
-        except KeyError:
-            return None

@@ -112,6 +112,13 @@ class RoutineBehaviour(BearingsBehaviour):
         if new_status != Status.RUNNING:
             self.set_output("command", STOP)
 
+    def written(self, port: str) -> Any:
+        """What this node last wrote to an output port (None before it wrote), for reports and views."""
+        try:
+            return self.bb.get(self.output_key(port))
+        except KeyError:
+            return None
+
     # -- motion through the motion nodes ---------------------------------------------------------
     def run_motion(self, node: BearingsBehaviour, what: str, expected: float) -> Step[None]:
         """Tick a motion node once per tick until it finishes; its failure (a stall) is :class:`Failed`,

@@ -27,7 +27,7 @@ from behaviours.registry import register
 from behaviours.roadmap.display import RoadmapDisplay, roadmap_section
 from behaviours.roadmap.values import HomingResult, TargetImages, TargetView
 from behaviours.roadmap.vision import FEATURES, describe
-from maps.roadmap import Roadmap
+from maps.roadmap import Roadmap, Target
 from maps.room import RoomEstimate
 from maps.store import InputError, read_bytes
 
@@ -137,8 +137,6 @@ def resolve_image(roadmap_file: Path, image: str) -> Path:
 
 def relative_images(roadmap: Roadmap, roadmap_file: str | os.PathLike) -> Roadmap:
     """The roadmap with image paths relative to the folder of the file it is saved to."""
-    from maps.roadmap import Target
-
     folder = Path(roadmap_file).resolve().parent
     targets = tuple(Target(t.name, t.pose, os.path.relpath(Path(t.image).resolve(), folder) if t.image else "")
                     for t in roadmap.targets)

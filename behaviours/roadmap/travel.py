@@ -57,7 +57,7 @@ class GoToPose(RoutineBehaviour):
         self.feedback_message = f"arrived after {plan.length:.1f} m"
 
     def log_rerun(self, rec: Any) -> None:
-        self.display.log_plan(rec, _read(self, "plan"))
+        self.display.log_plan(rec, self.written("plan"))
 
 
 @register
@@ -104,11 +104,4 @@ class ReturnToReference(RoutineBehaviour):
         return {"roadmap": {f"reference_drift_m ({self.name})": [round(c, 4) for c in self.corrections]}}
 
     def log_rerun(self, rec: Any) -> None:
-        self.display.log_plan(rec, _read(self, "plan"))
-
-
-def _read(node: RoutineBehaviour, port: str) -> Any:
-    try:
-        return node.bb.get(node.output_key(port))
-    except KeyError:
-        return None
+        self.display.log_plan(rec, self.written("plan"))

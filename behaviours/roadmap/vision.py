@@ -19,7 +19,6 @@ Choices where the paper is vague:
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -118,7 +117,3 @@ def mean_angle(a: float, b: float) -> float:
     """The circular mean of two angles (rad)."""
     return wrap_angle(a + wrap_angle(b - a) / 2.0)
 
-
-def heading_of(bearing: float) -> tuple[float, float]:
-    """Unit (x, y) of an azimuth."""
-    return math.cos(bearing), math.sin(bearing)
