@@ -70,7 +70,7 @@ class RoadmapDisplay:
         return True
 
     def log_room(self, rec: Any, room: RoomEstimate | None) -> None:
-        if room is None or not self._changed("room", room):
+        if room is None or not self._changed("room", room.polygon):  # re-anchoring keeps the map: not again
             return
         loop = np.vstack([room.polygon, room.polygon[:1]])
         rec.log("roadmap/room/free", rec.LineStrips2D([loop], colors=[[40, 160, 40]], radii=0.02))
