@@ -14,7 +14,8 @@ image after a step of known length". One round here:
 3. **Step**: move the camera ``step`` metres PERPENDICULAR to the estimated direction of the
    target (best conditioned triangle), driving backwards when that is closer to the current
    heading than driving forwards (no turn over 90 deg), then turn back to the first heading and
-   look again: the third image. A stall, or no match after the step, tries the other side.
+   look again: the third image. With a room estimate (``room``), the side whose step ends on
+   free floor goes first; a stall, or no match after the step, tries the other side.
 4. **Triangulate** (:func:`perception.planar.distance_from_third_image`): the two homing rays
    meet where the target image was taken. The camera pose there is that point with the mean of
    the two estimated headings; the robot pose follows from the camera's place on the robot. The
@@ -23,7 +24,8 @@ image after a step of known length". One round here:
    of one such pair then disagree by 5-15 degrees (measured in a 4.5 x 3.5 m room). A triangle
    that fails (no match after the step, no parallax, disagreement) is not driven on: the image
    after the step starts the next triangle, on the other side.
-5. **Go**: drive there and turn to its heading. When the estimate is within ``done_distance``
+5. **Go**: drive there (along a planned path when a room estimate is known and the goal is more
+   than 0.5 m away) and turn to its heading. When the estimate is within ``done_distance``
    of where the robot stood when the round began, the robot was there already: homing
    succeeds, and the result is that estimated pose (in the odometry frame), not the odometry
    after driving (which adds the drive's error). So homing takes at least two rounds: one to
