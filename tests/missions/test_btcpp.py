@@ -45,6 +45,7 @@ EVERY_NODE_TYPE = """
     cameras: [panorama]
     sense:
       - Perceive: {camera: panorama, max_features: 300, observation: "{/perception/panorama}"}
+      - CorrectOdometry
     tree:
       Sequence:
         name: every node type
@@ -109,6 +110,26 @@ EVERY_NODE_TYPE = """
                             - FollowRoute: {observation: "{/perception/panorama}"}
                             - ViewframeSwitch
                       - SearchPattern: {observation: "{/perception/panorama}"}
+          - Sequence:
+              name: the roadmap nodes
+              children:
+                - LoadTargetImages: {folder: targets}
+                - CalibrateTurns
+                - RoomEstimationDodecagon: {side: 0.25}
+                - Selector:
+                    children:
+                      - AllTargetsFound
+                      - Sequence:
+                          children:
+                            - CoverageScoring
+                            - GoToPose: {goal: "{/map/coverage_goal}"}
+                            - ScanForTargets
+                            - TargetHoming: {room: "{/map/room}"}
+                            - ReturnToReference
+                            - RecordTarget
+                - BuildGraph: {file: learned.roadmap, odometry: "{/robot/calibrated_odometry}"}
+                - LoadRoadmap: {file: learned.roadmap}
+                - NavigateToTarget: {target: door}
           - Stop
 """
 
@@ -376,11 +397,12 @@ def _literal(port: InputPort) -> st.SearchStrategy[Any] | None:
 
 
 def _reference(port: InputPort) -> st.SearchStrategy[str] | None:
+    """A reference the data-gathering branch can feed: a sensed key of the port's type (or an
+    odometry attribute for a number)."""
     if port.literal_only:
         return None
-    refs = {float: FLOAT_REFS, bool: ("/robot/stalled",), dict: ("/perception/frames",)}.get(port.type)
-    if refs is None and getattr(port.type, "__name__", "") == "Pose2D":
-        refs = ("/robot/odometry",)
+    refs = [key for key, written in SENSED_TYPES.items() if written is port.type]
+    refs += list(FLOAT_REFS) if port.type is float else []
     return st.sampled_from([f"{{{key}}}" for key in refs]) if refs else None
 
 
@@ -406,7 +428,8 @@ def node_bodies(draw, node_type) -> dict[str, Any]:
     return body
 
 
-SENSED = {port.key for cls in SENSE_NODES for port in NodeType.of(cls).outputs}
+SENSED_TYPES = {port.key: port.type for cls in SENSE_NODES for port in NodeType.of(cls).outputs}
+SENSED = set(SENSED_TYPES)
 
 
 def _fed_by_sensing(node_type: NodeType) -> bool:
