@@ -220,7 +220,8 @@ class Simulation:
         """The ``ground_truth`` section of a run report (DESIGN.md, contracts).
 
         Always: ``trajectory_length_m``, ``final_pose``, ``odometry_drift_m``, ``collisions``,
-        ``stalled_time_s``, ``trajectory`` (decimated) and the true ``landmarks``; with ``goal``
+        ``stalled_time_s``, ``trajectory`` (decimated), ``stops`` (every stretch the robot stood
+        still, exactly: see :func:`_stops`) and the true ``landmarks``; with ``goal``
         (x, y): ``goal_error_m``; with a ``reference_path`` of (x, y) points: ``path_error_m``
         (mean distance of the trajectory to it) and ``path_error_max_m``. ``goal`` and
         ``reference_path`` are world coordinates, or with ``frame="start"`` coordinates relative
@@ -243,6 +244,7 @@ class Simulation:
             "collisions": int(self.collisions),
             "stalled_time_s": float(self._stalled_time),
             "trajectory": _decimate(true, max_points=2000),
+            "stops": _stops(true),
             "landmarks": [[int(lm.id), lm.x, lm.y, lm.z] for lm in self.world.landmarks],
         }
         if goal is not None:
@@ -322,6 +324,28 @@ def _world_to_start(start: Sequence[float], xy: np.ndarray) -> np.ndarray:
     c, s = math.cos(th0), math.sin(th0)
     rel = xy - (x0, y0)
     return np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])
+
+
+def _stops(rows: np.ndarray, *, tolerance: float = 1e-4) -> list[list[float]]:
+    """Every stretch of (t, x, y, theta) rows over which the pose stayed within ``tolerance`` (m,
+    rad) of its first row: ``[t_first, t_last, x, y, theta]``, rounded as the trajectory.
+
+    The decimated trajectory cannot say where the robot was at a given time to better than its
+    spacing (up to half a second in a long run, with a turn starting right after a still image);
+    an evaluation that needs the true pose when an image was taken finds the stop holding that
+    time here instead (images are taken standing still)."""
+    if len(rows) < 2:
+        return []
+    moved = np.any(np.abs(np.diff(rows[:, 1:4], axis=0)) > tolerance, axis=1)
+    out, first = [], 0
+    for i, step in enumerate(moved, start=1):  # a stop is broken by the first row that moved from it
+        if step or np.any(np.abs(rows[i, 1:4] - rows[first, 1:4]) > tolerance):
+            if i - 1 > first:
+                out.append([rows[first, 0], rows[i - 1, 0], *rows[first, 1:4]])
+            first = i
+    if len(rows) - 1 > first:
+        out.append([rows[first, 0], rows[-1, 0], *rows[first, 1:4]])
+    return np.round(np.asarray(out, dtype=np.float64), 4).tolist() if out else []
 
 
 def _decimate(rows: np.ndarray, *, max_points: int) -> list[list[float]]:
