@@ -326,9 +326,10 @@ def _world_to_start(start: Sequence[float], xy: np.ndarray) -> np.ndarray:
     return np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])
 
 
-def _stops(rows: np.ndarray, *, tolerance: float = 1e-4) -> list[list[float]]:
-    """Every stretch of (t, x, y, theta) rows over which the pose stayed within ``tolerance`` (m,
-    rad) of its first row: ``[t_first, t_last, x, y, theta]``, rounded as the trajectory.
+def _stops(rows: np.ndarray, *, tolerance: float = 1e-6) -> list[list[float]]:
+    """Every stretch of (t, x, y, theta) rows over which the robot stood still (no step moved it
+    more than ``tolerance`` m or rad: a still robot does not move at all in the simulator):
+    ``[t_first, t_last, x, y, theta]``, rounded as the trajectory.
 
     The decimated trajectory cannot say where the robot was at a given time to better than its
     spacing (up to half a second in a long run, with a turn starting right after a still image);
@@ -336,16 +337,11 @@ def _stops(rows: np.ndarray, *, tolerance: float = 1e-4) -> list[list[float]]:
     time here instead (images are taken standing still)."""
     if len(rows) < 2:
         return []
-    moved = np.any(np.abs(np.diff(rows[:, 1:4], axis=0)) > tolerance, axis=1)
-    out, first = [], 0
-    for i, step in enumerate(moved, start=1):  # a stop is broken by the first row that moved from it
-        if step or np.any(np.abs(rows[i, 1:4] - rows[first, 1:4]) > tolerance):
-            if i - 1 > first:
-                out.append([rows[first, 0], rows[i - 1, 0], *rows[first, 1:4]])
-            first = i
-    if len(rows) - 1 > first:
-        out.append([rows[first, 0], rows[-1, 0], *rows[first, 1:4]])
-    return np.round(np.asarray(out, dtype=np.float64), 4).tolist() if out else []
+    still = np.all(np.abs(np.diff(rows[:, 1:4], axis=0)) <= tolerance, axis=1).astype(np.int8)
+    edges = np.diff(np.concatenate([[0], still, [0]]))
+    first, end = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # step runs [first, end)
+    out = np.column_stack([rows[first, 0], rows[end, 0], rows[first, 1:4]])
+    return np.round(out, 4).tolist()
 
 
 def _decimate(rows: np.ndarray, *, max_points: int) -> list[list[float]]:
