@@ -373,7 +373,7 @@ def format_table(figures: Mapping[str, Any]) -> str:
         f"{_cell(rate, 2)}); error worst {_pair(f['goto.error_worst_m'], f['goto.heading_error_worst_deg'])}, mean "
         f"{_pair(f['goto.error_mean_m'], f['goto.heading_error_mean_deg'])}",
         "",
-        f"{'seed':>4} {'run':<18} {'status':<8} {'result':<34} {'error':<22} {'sim s':>7} {'wall s':>7}",
+        f"{'seed':>4} {'run':<18} {'status':<8} {'result':<38} {'error':<24} {'sim s':>7} {'wall s':>7}",
     ]
     lines += [_run_line(run) for run in f["runs"]]
     lines += [f"seed {x['seed']} {x['episode']}: {x['status']}: {x['reason']}" for x in f["failures"]]
@@ -385,11 +385,12 @@ def _run_line(run: Mapping[str, Any]) -> str:
         what = "learn"
         result = (f"found {run['found']}/{run['targets']}, within {run['within']}, "
                   f"{'connected' if run['connected'] else 'not connected'} {run['edges']} edges")
-        worst = max(run["target_errors"].values(), key=lambda e: e["position_m"], default=None)
-        error = "-" if worst is None else "worst " + _pair(worst["position_m"], worst["heading_deg"])
+        errors = list(run["target_errors"].values())
+        error = "-" if not errors else "worst " + _pair(max(e["position_m"] for e in errors),
+                                                        max(e["heading_deg"] for e in errors))
     else:
         what = f"goto {run['number']} -> {run['goal']}"
         result = "reached" if run["reached"] else "not reached"
         error = _pair(run["error_m"], run["error_deg"]) if run["error_m"] is not None else "-"
-    return (f"{run['seed']:>4} {what:<18} {run['status']:<8} {result:<34} {error:<22} "
+    return (f"{run['seed']:>4} {what:<18} {run['status']:<8} {result:<38} {error:<24} "
             f"{_cell(run['sim_time_s'], 0):>7} {_cell(run['wall_time_s'], 0):>7}")
