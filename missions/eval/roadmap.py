@@ -59,14 +59,14 @@ from missions.sweep.episode import absolute_if_file
 from missions.sweep.table import REPORTS
 from perception.geometry import Pose2D
 
+DEFAULT_STARTS, MAX_STARTS = 5, 1000
 DESCRIPTION = "learn a roadmap from target images, navigate to them: target pose errors, graph, goto reached"
 OPTIONS = {
     "targets": "the named poses of the world to take target images at, a,b,c (default: every one the robot can "
                "stand at and reach from the start; at least 2)",
-    "starts": f"random start poses per seed to navigate from (default {5}; 0: learning only)",
+    "starts": f"random start poses per seed to navigate from (default {DEFAULT_STARTS}; 0: learning only)",
 }
 LEARN, GOTO = "learn_targets", "goto_target"
-DEFAULT_STARTS, MAX_STARTS = 5, 1000
 POSITION_OK, HEADING_OK = 0.15, 5.0  # m, deg: the issue's thresholds for a target and a navigation
 CAMERAS = {"front": "pinhole", "stereo": "stereo"}  # what learn_targets reads (name: kind)
 SEEDS = "seeds"
@@ -151,6 +151,7 @@ def parse_targets(text: str, world: World, usable: Mapping[str, Pose2D]) -> tupl
 
 
 def seed_folder(folder: Path, world: str, seed: int) -> Path:
+    """Where a seed's target images and roadmap file go (episodes of other seeds never share them)."""
     return folder / SEEDS / f"{Path(world).stem}_s{seed:04d}"
 
 
@@ -177,8 +178,13 @@ def goto_plans(learn: Episode, world: World, found: Sequence[str], starts: int,
 
 
 def _report(folder: Path, episode: Episode) -> dict[str, Any] | None:
+    """The episode's run report; None when it gave none (or an unreadable one: the run is an ERROR)."""
     path = folder / REPORTS / f"{episode.id}.json"
-    return json.loads(path.read_text()) if path.exists() else None
+    try:
+        report = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return report if isinstance(report, dict) else None
 
 
 def _outcome(report: Mapping[str, Any] | None, row: Mapping[str, Any] | None) -> dict[str, Any]:

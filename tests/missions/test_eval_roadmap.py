@@ -16,6 +16,7 @@ from missions.cli import main
 from missions.eval.roadmap import (
     GotoPlan,
     Settings,
+    _report,
     check_options,
     check_world,
     format_table,
@@ -229,3 +230,12 @@ def test_the_evaluation_in_the_small_room(world_file, tmp_path, capsys):
     assert sorted(p.name for p in (out / "seeds" / "small_s0000" / "targets").iterdir()) == ["a.png", "b.png"]
     assert len((out / "results.jsonl").read_text().splitlines()) == 2  # one learn, one goto
     assert learn["sim_time_s"] > 100 and learn["wall_time_s"] > 0
+
+
+def test_a_torn_report_is_a_run_without_one(tmp_path):
+    episode = Episode("learn_targets", "lab", 0, {"targets": "t", "roadmap": "r"})
+    (tmp_path / "reports").mkdir()
+    (tmp_path / "reports" / f"{episode.id}.json").write_text('{"status": "SUCC')  # a writer killed mid-write
+    assert _report(tmp_path, episode) is None
+    row = {"status": "ERROR", "reason": "killed by SIGKILL"}
+    assert learn_figures(0, _report(tmp_path, episode), row, {})["reason"] == "killed by SIGKILL"
