@@ -25,6 +25,7 @@ from typing import TextIO
 
 AREAS = {
     "ltmap": "missions.eval.ltmap",
+    "roadmap": "missions.eval.roadmap",
 }
 
 
