@@ -24,6 +24,8 @@ Episodes (all through the sweep runner, in the results folder), per seed:
 
 Figures (simulator ground truth, evaluation only):
 
+- where the targets came from, ``targets.source`` (``"named poses"`` or ``"placed"``), and where
+  they are, ``targets.poses`` (per seed, ``[x m, y m, theta deg]`` in the world frame);
 - per target found: its estimated pose (the report's ``roadmap.targets``, reference frame) against
   its true pose expressed in the TRUE reference frame, the robot's true pose at the report's
   ``roadmap.room.reference_stamp`` (:class:`~missions.eval.roadmap_world.TrueTrajectory`: exact,

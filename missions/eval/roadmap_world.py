@@ -10,7 +10,10 @@ per named pose of the world, named after the pose::
     write_target_images("lab", ["door", "window"], tmp_path / "targets")
 
 ``world_with(world, out, start=..., poses=...)`` writes a copy of a world file with another start
-pose and extra named poses (targets anywhere). :class:`TrueTrajectory` reads where the robot truly
+pose and extra named poses (targets anywhere). :func:`place_targets` places targets in a world's
+free space (for a world without enough named poses): free as :func:`random_starts` (both draw
+through :class:`FreeFloor`), apart, and facing surfaces in range (:func:`best_heading`, with the
+simulator's own ray casting). :class:`TrueTrajectory` reads where the robot truly
 was at a time from a report's ``ground_truth`` section (exact while it stood still, from the
 section's ``stops``; interpolated between the decimated trajectory's rows otherwise).
 """
