@@ -4,9 +4,15 @@ from unknown start poses (DESIGN.md's algorithm 2, ``docs/roadmap.md``).
 Episodes (all through the sweep runner, in the results folder), per seed:
 
 1. **Target images**: one front-camera image per target, made with ``bearings sim snapshot`` at the
-   world's named poses (lighting of the seed) into ``seeds/<world>_s<seed>/targets/``. The targets
-   are the world's named poses where the robot can stand and that it can reach from the start
-   (``--option targets=a,b,c`` chooses among them; at least 2).
+   target poses (lighting of the seed) into ``seeds/<world>_s<seed>/targets/``. The targets are
+   either the world's **named poses** where the robot can stand and that it can reach from the
+   start (``--option targets=a,b,c`` chooses among them; at least 2), or ``t1``..``tN`` **placed**
+   in the free space (``--option targets=N``, 2 to 12; the default, 4 of them, when the world has
+   fewer than 2 usable named poses): drawn from the seed by
+   :func:`~missions.eval.roadmap_world.place_targets` (reachable, 0.45 m clear, 1.5 m apart, the
+   front camera facing at least two surfaces 1-5 m away on every ray across its view). Placed
+   targets are added to a copy of the world file, ``seeds/<world>_s<seed>/<world>.yaml``, and that
+   seed's snapshots, learn and goto episodes all run in the copy (self-contained, resumable).
 2. **Learn**: ``learn_targets`` from the world's start with that folder; it writes the roadmap to
    ``seeds/<world>_s<seed>/<world>.roadmap``.
 3. **Goto**: ``goto_target`` from ``--option starts=N`` random start poses (default 5;
@@ -18,6 +24,8 @@ Episodes (all through the sweep runner, in the results folder), per seed:
 
 Figures (simulator ground truth, evaluation only):
 
+- where the targets came from, ``targets.source`` (``"named poses"`` or ``"placed"``), and where
+  they are, ``targets.poses`` (per seed, ``[x m, y m, theta deg]`` in the world frame);
 - per target found: its estimated pose (the report's ``roadmap.targets``, reference frame) against
   its true pose expressed in the TRUE reference frame, the robot's true pose at the report's
   ``roadmap.room.reference_stamp`` (:class:`~missions.eval.roadmap_world.TrueTrajectory`: exact,
@@ -47,37 +55,54 @@ from drivers.sim.world import World, load_world
 from missions.eval import EvalOptions
 from missions.eval.roadmap_world import (
     TrueTrajectory,
+    place_targets,
     pose_error,
     random_starts,
     reachable_grid,
     target_errors,
     usable_poses,
+    world_path,
+    world_with,
     write_target_images,
 )
 from missions.sweep import Episode, run_sweep
-from missions.sweep.episode import absolute_if_file
+from missions.sweep.episode import SweepInputError, absolute_if_file
 from missions.sweep.table import REPORTS
 from perception.geometry import Pose2D
 
 DEFAULT_STARTS, MAX_STARTS = 5, 1000
 DESCRIPTION = "learn a roadmap from target images, navigate to them: target pose errors, graph, goto reached"
 OPTIONS = {
-    "targets": "the named poses of the world to take target images at, a,b,c (default: every one the robot can "
-               "stand at and reach from the start; at least 2)",
+    "targets": "the named poses of the world to take target images at, a,b,c (at least 2), or a count N (2 to 12) "
+               "of targets placed in the free space from the seed (default: every named pose the robot can stand "
+               "at and reach from the start; 4 placed when fewer than 2)",
     "starts": f"random start poses per seed to navigate from (default {DEFAULT_STARTS}; 0: learning only)",
 }
 LEARN, GOTO = "learn_targets", "goto_target"
 POSITION_OK, HEADING_OK = 0.15, 5.0  # m, deg: the issue's thresholds for a target and a navigation
 CAMERAS = {"front": "pinhole", "stereo": "stereo"}  # what learn_targets reads (name: kind)
 SEEDS = "seeds"
+NAMED, PLACED = "named poses", "placed"  # where the targets come from (the figures' targets.source)
+DEFAULT_PLACED, MIN_TARGETS, MAX_TARGETS = 4, 2, 12
 
 
 @dataclass(frozen=True)
 class Settings:
-    """The area's options, checked."""
+    """The area's options, checked: the target names (``t1``..``tN`` when placed), how many starts,
+    and where the targets come from (``NAMED`` or ``PLACED``)."""
 
     targets: tuple[str, ...]
     starts: int
+    source: str = NAMED
+
+
+@dataclass(frozen=True)
+class SeedTargets:
+    """One seed's targets: the world its episodes run in (the world itself, or the copy with the
+    placed targets as named poses) and the targets' true poses (world frame)."""
+
+    world: str
+    poses: dict[str, Pose2D]
 
 
 @dataclass(frozen=True)
@@ -94,39 +119,66 @@ class GotoPlan:
 
 
 def check_world(world: str) -> World:
-    """The world, loaded, with the cameras ``learn_targets`` reads and at least 2 usable named poses."""
+    """The world, loaded, with the cameras ``learn_targets`` reads. Its named poses do not matter
+    here: without 2 usable ones the targets are placed in the free space (``check_options``)."""
     loaded = load_world(world)
     kinds = {spec.name: spec.kind for spec in loaded.cameras}
     missing = [f"{name} ({kind})" for name, kind in CAMERAS.items() if kinds.get(name) != kind]
     if missing:
         raise ValueError(f"world {loaded.name!r} has no {' or '.join(missing)} camera: learn_targets needs them")
-    usable = usable_poses(loaded)
-    if len(usable) < 2:
-        has = ", ".join(sorted(loaded.poses)) or "none"
-        raise ValueError(f"world {loaded.name!r} has {len(usable)} named pose(s) the robot can stand at and reach "
-                         f"from the start (named poses: {has}); the roadmap evaluation needs at least 2 as targets")
     return loaded
 
 
 def check_options(world: str, extra: Mapping[str, str]) -> Settings:
-    """The options (``OPTIONS``) checked against the world; ``ValueError`` with the problem."""
+    """The options (``OPTIONS``) checked against the world; ``ValueError`` with the problem. Placed
+    targets are placed for seed 0 here, so that a world without room for them is refused before
+    any episode runs."""
     loaded = load_world(world)
     grid = reachable_grid(loaded)
-    usable = usable_poses(loaded, grid)
-    targets = parse_targets(extra["targets"], loaded, usable) if "targets" in extra else tuple(sorted(usable))
-    if len(targets) < 2:
-        raise ValueError(f"targets: at least 2 are needed, world {loaded.name!r} gives {len(targets)}")
-    starts = DEFAULT_STARTS
-    if "starts" in extra:
-        try:
-            starts = int(extra["starts"])
-        except ValueError:
-            raise ValueError(f"starts: an integer expected, got {extra['starts']!r}") from None
-        if not 0 <= starts <= MAX_STARTS:
-            raise ValueError(f"starts must be 0 to {MAX_STARTS}, got {starts}")
+    targets, source = choose_targets(extra.get("targets"), loaded, usable_poses(loaded, grid))
+    if source == PLACED:
+        place_targets(loaded, len(targets), 0, grid=grid)  # ValueError: no room for them
+    starts = parse_starts(extra.get("starts"))
     if starts:
         random_starts(loaded, 1, 0, grid=grid)  # ValueError: nowhere clear enough to start from
-    return Settings(targets, starts)
+    return Settings(targets, starts, source)
+
+
+def choose_targets(text: str | None, world: World, usable: Mapping[str, Pose2D]) -> tuple[tuple[str, ...], str]:
+    """The target names and their source from the ``targets`` option: a count N (digits) places
+    ``t1``..``tN``; names are named poses; none: the usable named poses, or ``DEFAULT_PLACED``
+    placed targets when there are fewer than 2 of them."""
+    if text is None:
+        if len(usable) >= MIN_TARGETS:
+            return tuple(sorted(usable)), NAMED
+        return placed_names(DEFAULT_PLACED), PLACED
+    if text.strip().isdigit():
+        count = int(text)
+        if not MIN_TARGETS <= count <= MAX_TARGETS:
+            raise ValueError(f"targets: a count must be {MIN_TARGETS} to {MAX_TARGETS}, got {count}")
+        return placed_names(count), PLACED
+    names = parse_targets(text, world, usable)
+    if len(names) < MIN_TARGETS:
+        raise ValueError(f"targets: at least {MIN_TARGETS} are needed, {text!r} gives {len(names)}")
+    return names, NAMED
+
+
+def placed_names(count: int) -> tuple[str, ...]:
+    """``t1``..``tN``: the names of placed targets."""
+    return tuple(f"t{k}" for k in range(1, count + 1))
+
+
+def parse_starts(text: str | None) -> int:
+    """The ``starts`` option: 0 to ``MAX_STARTS`` (default ``DEFAULT_STARTS``)."""
+    if text is None:
+        return DEFAULT_STARTS
+    try:
+        starts = int(text)
+    except ValueError:
+        raise ValueError(f"starts: an integer expected, got {text!r}") from None
+    if not 0 <= starts <= MAX_STARTS:
+        raise ValueError(f"starts must be 0 to {MAX_STARTS}, got {starts}")
+    return starts
 
 
 def parse_targets(text: str, world: World, usable: Mapping[str, Pose2D]) -> tuple[str, ...]:
@@ -151,8 +203,25 @@ def parse_targets(text: str, world: World, usable: Mapping[str, Pose2D]) -> tupl
 
 
 def seed_folder(folder: Path, world: str, seed: int) -> Path:
-    """Where a seed's target images and roadmap file go (episodes of other seeds never share them)."""
+    """Where a seed's target images, roadmap file and world copy go (other seeds never share them)."""
     return folder / SEEDS / f"{Path(world).stem}_s{seed:04d}"
+
+
+def seed_targets(world: str, loaded: World, settings: Settings, seed: int, folder: Path) -> SeedTargets:
+    """The seed's targets. Named poses: the world as it is. Placed: ``place_targets`` from the seed,
+    written as named poses into a copy of the world file in the seed's folder (same file name, so
+    the world keeps its name and the episodes' ids their world part); ``SweepInputError`` when the
+    world has no room for them with this seed."""
+    if settings.source == NAMED:
+        return SeedTargets(world, {name: loaded.poses[name] for name in settings.targets})
+    try:
+        poses = place_targets(loaded, len(settings.targets), seed)
+    except ValueError as exc:
+        raise SweepInputError(f"seed {seed}: {exc}") from None
+    here = seed_folder(folder, world, seed)
+    here.mkdir(parents=True, exist_ok=True)
+    copy = world_with(world, here / f"{Path(world_path(world)).stem}.yaml", poses=poses)
+    return SeedTargets(str(copy), poses)
 
 
 def learn_episode(world: str, seed: int, folder: Path, max_time_s: float | None) -> Episode:
@@ -264,9 +333,16 @@ def _worst(values: Sequence[Any]) -> float | None:
     return max(present) if present else None
 
 
-def summarise(world: str, settings: Settings, learns: list[dict[str, Any]],
-              gotos: list[dict[str, Any]]) -> dict[str, Any]:
-    """The named figures of the whole evaluation from its runs' figures (one flat object)."""
+def pose_rows(poses: Mapping[int, Mapping[str, Pose2D]]) -> dict[str, dict[str, list[float]]]:
+    """Per seed (a string: a JSON key), each target's true pose as ``[x m, y m, theta deg]``."""
+    return {str(seed): {name: [round(p.x, 3), round(p.y, 3), round(math.degrees(p.theta), 1)]
+                        for name, p in by_name.items()} for seed, by_name in sorted(poses.items())}
+
+
+def summarise(world: str, settings: Settings, learns: list[dict[str, Any]], gotos: list[dict[str, Any]],
+              poses: Mapping[int, Mapping[str, Pose2D]] | None = None) -> dict[str, Any]:
+    """The named figures of the whole evaluation from its runs' figures (one flat object); ``poses``:
+    each seed's target poses (world frame), recorded with where they came from."""
     errors = [e for run in learns for e in run["target_errors"].values()]
     measured = [g for g in gotos if g["error_m"] is not None]
     reached = sum(g["reached"] for g in gotos)
@@ -274,6 +350,8 @@ def summarise(world: str, settings: Settings, learns: list[dict[str, Any]],
         "world": world,
         "seeds": len(learns),
         "targets": list(settings.targets),
+        "targets.source": settings.source,
+        "targets.poses": pose_rows(poses or {}),
         "starts": settings.starts,
         "criterion": f"within {POSITION_OK:g} m and {HEADING_OK:g} deg (a goto: and SUCCESS)",
         "learn.succeeded": sum(run["status"] == "SUCCESS" for run in learns),
@@ -311,11 +389,11 @@ def _failure(run: Mapping[str, Any]) -> dict[str, Any]:
 # The evaluation
 
 
-def _learn_phase(options: EvalOptions, world: str, settings: Settings, folder: Path,
+def _learn_phase(options: EvalOptions, targets: Mapping[int, SeedTargets], settings: Settings, folder: Path,
                  resume: bool) -> tuple[dict[int, Episode], dict[str, dict[str, Any]]]:
-    episodes = {seed: learn_episode(world, seed, folder, options.max_time_s) for seed in options.seeds}
+    episodes = {seed: learn_episode(targets[seed].world, seed, folder, options.max_time_s) for seed in options.seeds}
     for seed, episode in episodes.items():
-        write_target_images(world, settings.targets, Path(episode.inputs["targets"]), seed=seed)
+        write_target_images(targets[seed].world, settings.targets, Path(episode.inputs["targets"]), seed=seed)
     rows = run_sweep(list(episodes.values()), executor=options.executor, results_dir=folder,
                      timeout_s=options.timeout_s, progress=options.progress, resume=resume)
     return episodes, {row["id"]: row for row in rows}
@@ -327,11 +405,12 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     settings = check_options(options.world, options.extra)
     world = absolute_if_file(options.world)  # episodes run in other processes
     folder = Path(options.results_dir).resolve()
-    truth = {name: loaded.poses[name] for name in settings.targets}
-    episodes, rows = _learn_phase(options, world, settings, folder, resume)
+    targets = {seed: seed_targets(world, loaded, settings, seed, folder) for seed in options.seeds}
+    truth = {seed: t.poses for seed, t in targets.items()}
+    episodes, rows = _learn_phase(options, targets, settings, folder, resume)
     learns, plans = [], []
     for seed, episode in sorted(episodes.items()):
-        figures = learn_figures(seed, _report(folder, episode), rows.get(episode.id), truth)
+        figures = learn_figures(seed, _report(folder, episode), rows.get(episode.id), truth[seed])
         learns.append(figures)
         found = sorted(figures["target_errors"])
         if settings.starts and found and Path(episode.inputs["roadmap"]).is_file():
@@ -341,8 +420,9 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         done = run_sweep([p.episode for p in plans], executor=options.executor, results_dir=folder,
                          timeout_s=options.timeout_s, progress=options.progress, resume=True)
         rows = {row["id"]: row for row in done}
-    gotos = [goto_figures(p, _report(folder, p.episode), rows.get(p.episode.id), truth[p.goal]) for p in plans]
-    return summarise(loaded.name, settings, learns, gotos)
+    gotos = [goto_figures(p, _report(folder, p.episode), rows.get(p.episode.id), truth[p.episode.seed][p.goal])
+             for p in plans]
+    return summarise(loaded.name, settings, learns, gotos, truth)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -366,8 +446,8 @@ def format_table(figures: Mapping[str, Any]) -> str:
     f = figures
     rate = f["goto.reached_rate"]
     lines = [
-        f"roadmap in {f['world']}: {f['seeds']} seed(s), targets {', '.join(f['targets'])}, {f['starts']} goto "
-        f"start(s) per seed; {f['criterion']}",
+        f"roadmap in {f['world']}: {f['seeds']} seed(s), targets {', '.join(f['targets'])} "
+        f"({f.get('targets.source', NAMED)}), {f['starts']} goto start(s) per seed; {f['criterion']}",
         f"learn: {f['learn.succeeded']} of {f['seeds']} succeeded; sim {_cell(f['learn.sim_time_s'], 0)} s, wall "
         f"{_cell(f['learn.wall_time_s'], 0)} s (means)",
         f"targets found {f['targets.found']} of {f['targets.total']}, within {f['targets.within']}; error worst "
@@ -382,6 +462,10 @@ def format_table(figures: Mapping[str, Any]) -> str:
         f"{'seed':>4} {'run':<18} {'status':<8} {'result':<38} {'error':<24} {'sim s':>7} {'wall s':>7}",
     ]
     lines += [_run_line(run) for run in f["runs"]]
+    if f.get("targets.source") == PLACED:
+        lines += [f"seed {seed} placed targets: " + ", ".join(f"{n} ({x:g}, {y:g}, {deg:g} deg)"
+                                                               for n, (x, y, deg) in by_name.items())
+                  for seed, by_name in f["targets.poses"].items()]
     lines += [f"seed {x['seed']} {x['episode']}: {x['status']}: {x['reason']}" for x in f["failures"]]
     return "\n".join(lines)
 

@@ -10,7 +10,10 @@ per named pose of the world, named after the pose::
     write_target_images("lab", ["door", "window"], tmp_path / "targets")
 
 ``world_with(world, out, start=..., poses=...)`` writes a copy of a world file with another start
-pose and extra named poses (targets anywhere). :class:`TrueTrajectory` reads where the robot truly
+pose and extra named poses (targets anywhere). :func:`place_targets` places targets in a world's
+free space (for a world without enough named poses): free as :func:`random_starts` (both draw
+through :class:`FreeFloor`), apart, and facing surfaces in range (:func:`best_heading`, with the
+simulator's own ray casting). :class:`TrueTrajectory` reads where the robot truly
 was at a time from a report's ``ground_truth`` section (exact while it stood still, from the
 section's ``stops``; interpolated between the decimated trajectory's rows otherwise).
 """
@@ -20,20 +23,29 @@ from __future__ import annotations
 import contextlib
 import io
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import yaml
 
+from drivers.sim.cameras import camera_pose
 from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, load_world, shipped_worlds
 from perception.geometry import Pose2D, wrap_angle
 
-START_CLEARANCE = 0.45  # m: a random start is at least this far from any wall, box or pillar
-MAX_DRAWS = 100_000  # random positions tried per start before giving up (a world with no room)
+START_CLEARANCE = 0.45  # m: a random start (and a placed target) is at least this far from any wall, box or pillar
+MAX_DRAWS = 100_000  # random positions tried per start (per placed target) before giving up (a world with no room)
+TARGET_SPACING = 1.5  # m: placed targets at least this far apart (distinct places, not one view twice)
+VIEW_RANGE = (1.0, 5.0)  # m: a placed target's camera sees surfaces this far away on every ray
+VIEW_RAYS = 7  # rays across the camera's centre row that must all see a surface in range
+HEADINGS = 24  # candidate headings of a placed target (every 15 deg)
+MIN_SURFACES = 2  # distinct surfaces a placed target's view must meet (one flat wall: the planar ambiguity)
+
+T = TypeVar("T")
 
 
 def world_path(world: str | Path) -> Path:
@@ -139,24 +151,149 @@ def usable_poses(world: World, grid: FloorGrid | None = None) -> dict[str, Pose2
             if ok and grid.reachable[r, c]}
 
 
+@dataclass(frozen=True)
+class FreeFloor:
+    """Where the robot can be put down: reachable from the world's start (the floor grid) and at
+    least ``clearance`` from any wall, box or pillar (the scene's exact distance). Shared by the
+    random starts and the placed targets, so both mean the same thing by "free"."""
+
+    world: World
+    grid: FloorGrid
+    scene: Scene
+    clearance: float
+
+    @classmethod
+    def of(cls, world: World, clearance: float, grid: FloorGrid | None = None) -> FreeFloor:
+        return cls(world, grid or reachable_grid(world), Scene(world), clearance)
+
+    def is_free(self, x: float, y: float) -> bool:
+        """Whether (x, y) is reachable and clear enough."""
+        row, col, inside = self.grid.cells_of(np.array([x, y]))
+        return bool(inside[0] and self.grid.reachable[row[0], col[0]]) and self.scene.clearance(x, y) >= self.clearance
+
+    def draw(self, rng: np.random.Generator, judge: Callable[[float, float], T | None]) -> T | None:
+        """The first of up to ``MAX_DRAWS`` positions uniform in the world's bounds that is free and
+        that ``judge`` accepts (its answer); None when none is."""
+        xmin, ymin, xmax, ymax = self.world.bounds()
+        for _ in range(MAX_DRAWS):
+            x, y = float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax))
+            if self.is_free(x, y):
+                judged = judge(x, y)
+                if judged is not None:
+                    return judged
+        return None
+
+
 def random_starts(world: World, count: int, seed: int, *, clearance: float = START_CLEARANCE,
                   grid: FloorGrid | None = None) -> list[Pose2D]:
     """``count`` start poses drawn from ``seed`` alone: positions uniform in the world's bounds, at
     least ``clearance`` from any wall, box or pillar (the scene's exact distance) and reachable from
     the world's start (the floor grid), any heading. ``ValueError`` when no such place turns up."""
-    grid = grid or reachable_grid(world)
-    scene = Scene(world)
-    xmin, ymin, xmax, ymax = world.bounds()
+    free = FreeFloor.of(world, clearance, grid)
     rng = np.random.default_rng([seed, 0x60A1])
     starts: list[Pose2D] = []
     for _ in range(count):
-        for _ in range(MAX_DRAWS):
-            x, y = float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax))
-            row, col, inside = grid.cells_of(np.array([x, y]))
-            if inside[0] and grid.reachable[row[0], col[0]] and scene.clearance(x, y) >= clearance:
-                starts.append(Pose2D(x, y, float(rng.uniform(-math.pi, math.pi))))
-                break
-        else:
+        place = free.draw(rng, lambda x, y: (x, y))
+        if place is None:
             raise ValueError(f"world {world.name!r} has no reachable place {clearance:g} m clear of every surface "
                              "to start from")
+        starts.append(Pose2D(*place, float(rng.uniform(-math.pi, math.pi))))
     return starts
+
+
+# ------------------------------------------------------------------------------------------------
+# Targets placed in the free space (a world without enough named poses)
+
+
+@dataclass(frozen=True)
+class View:
+    """What a camera's centre row looks at from one pose: along each of its rays (left to right),
+    the horizontal distance to the nearest wall, box or pillar that stands above the camera (inf:
+    none; a lower box is looked over), and which surfaces those are (indices of the scene's)."""
+
+    distances: tuple[float, ...]
+    surfaces: tuple[int, ...]
+
+    @property
+    def centre(self) -> float:
+        """Distance along the optical axis (the middle ray)."""
+        return self.distances[len(self.distances) // 2]
+
+    def within(self, near: float, far: float) -> bool:
+        """Whether every ray meets a surface between ``near`` and ``far`` m: the image is filled with
+        texture close enough for the stereo camera and far enough to be seen whole."""
+        return all(near <= d <= far for d in self.distances)
+
+
+def camera_rays(world: World, camera: str = "front", rays: int = VIEW_RAYS) -> np.ndarray:
+    """Azimuths (rad, relative to the robot's heading, pan and tilt 0) of ``rays`` pixels spread
+    evenly across the centre row of ``camera``'s image, from its own model and mount."""
+    spec = world.camera(camera)
+    model = spec.model
+    u = np.linspace(0.0, model.width - 1.0, rays)
+    body = model.pixel_to_bearing(np.column_stack([u, np.full(rays, (model.height - 1) / 2.0)]))
+    level = body @ camera_pose(spec, world.ptu, Pose2D()).rest.T
+    return np.arctan2(level[:, 1], level[:, 0])
+
+
+def camera_view(scene: Scene, world: World, pose: Pose2D, azimuths: np.ndarray, camera: str = "front") -> View:
+    """What ``camera`` sees along ``azimuths`` (:func:`camera_rays`) with the robot at ``pose``,
+    cast with the simulator's own scene geometry (``Scene.cast_columns``) from the camera's eye."""
+    where = camera_pose(world.camera(camera), world.ptu, pose)
+    distance, index = scene.cast_columns(where.eye, where.psi + azimuths)
+    tall = scene.heights[index] > where.eye[2]
+    distance = np.where(tall[None, :], distance, np.inf)
+    nearest = np.argmin(distance, axis=1) if distance.shape[1] else np.zeros(len(azimuths), dtype=int)
+    rows = np.arange(len(azimuths))
+    hit = distance[rows, nearest] if distance.shape[1] else np.full(len(azimuths), np.inf)
+    return View(tuple(float(d) for d in hit),
+                tuple(int(index[k]) if math.isfinite(d) else -1 for k, d in zip(nearest, hit, strict=True)))
+
+
+def best_heading(scene: Scene, world: World, x: float, y: float, azimuths: np.ndarray, *,
+                 view_range: tuple[float, float] = VIEW_RANGE, camera: str = "front") -> float | None:
+    """Of ``HEADINGS`` headings evenly round, among those whose view is within ``view_range`` on
+    every ray and meets at least ``MIN_SURFACES`` distinct surfaces (a single flat wall is the
+    planar essential matrix's ambiguous case: homing to it may fail), the one that meets the most,
+    then whose optical axis is nearest the middle of the range; None if none qualifies."""
+    near, far = view_range
+    best: tuple[int, float] | None = None
+    chosen = None
+    for k in range(HEADINGS):
+        theta = wrap_angle(2.0 * math.pi * k / HEADINGS)
+        view = camera_view(scene, world, Pose2D(x, y, theta), azimuths, camera)
+        surfaces = len(set(view.surfaces))
+        if not view.within(near, far) or surfaces < MIN_SURFACES:
+            continue
+        score = (surfaces, -abs(view.centre - (near + far) / 2.0))
+        if best is None or score > best:
+            best, chosen = score, theta
+    return chosen
+
+
+def place_targets(world: World, count: int, seed: int, *, clearance: float = START_CLEARANCE,
+                  spacing: float = TARGET_SPACING, view_range: tuple[float, float] = VIEW_RANGE,
+                  camera: str = "front", grid: FloorGrid | None = None) -> dict[str, Pose2D]:
+    """``count`` target poses ``t1``..``tN`` drawn from ``seed`` alone: free positions (as the random
+    starts: reachable, ``clearance`` from every surface), at least ``spacing`` apart, each with the
+    heading :func:`best_heading` chooses (a position where none is good is drawn again). The first
+    ones do not depend on ``count``. ``ValueError`` when the world has no room for them all."""
+    free = FreeFloor.of(world, clearance, grid)
+    azimuths = camera_rays(world, camera)
+    rng = np.random.default_rng([seed, 0x60A3])
+    placed: dict[str, Pose2D] = {}
+
+    def judge(x: float, y: float) -> Pose2D | None:
+        if any(math.hypot(x - p.x, y - p.y) < spacing for p in placed.values()):
+            return None
+        theta = best_heading(free.scene, world, x, y, azimuths, view_range=view_range, camera=camera)
+        return None if theta is None else Pose2D(x, y, theta)
+
+    for k in range(1, count + 1):
+        pose = free.draw(rng, judge)
+        if pose is None:
+            raise ValueError(f"world {world.name!r} has room for {len(placed)} target(s), not {count}: reachable, "
+                             f"{clearance:g} m clear, {spacing:g} m apart, the {camera} camera facing surfaces "
+                             f"{view_range[0]:g}-{view_range[1]:g} m away")
+        placed[f"t{k}"] = pose
+    return placed

@@ -1,6 +1,6 @@
-"""``bearings eval roadmap``: random starts, the true reference frame, the figures from hand-made runs,
-the option checks, and one whole evaluation in the small room (the lab's figures are measured by
-hand: docs/roadmap.md)."""
+"""``bearings eval roadmap``: random starts, targets placed in the free space, the true reference
+frame, the figures from hand-made runs, the option checks, and one whole evaluation in the small
+room (the lab's figures are measured by hand: docs/roadmap.md)."""
 
 from __future__ import annotations
 
@@ -8,12 +8,15 @@ import json
 import math
 import re
 
+import numpy as np
 import pytest
 
+from drivers.sim.cameras import camera_pose
 from drivers.sim.scene import Scene
 from drivers.sim.world import load_world
 from missions.cli import main
 from missions.eval.roadmap import (
+    PLACED,
     GotoPlan,
     Settings,
     _report,
@@ -23,9 +26,19 @@ from missions.eval.roadmap import (
     goto_figures,
     learn_figures,
     reference_truth,
+    seed_targets,
     summarise,
 )
-from missions.eval.roadmap_world import START_CLEARANCE, TrueTrajectory, random_starts, reachable_grid, usable_poses
+from missions.eval.roadmap_world import (
+    START_CLEARANCE,
+    TrueTrajectory,
+    camera_rays,
+    camera_view,
+    place_targets,
+    random_starts,
+    reachable_grid,
+    usable_poses,
+)
 from missions.sweep import Episode
 from perception.geometry import Pose2D
 from tests.missions.test_roadmap_missions import SMALL_ROOM
@@ -48,6 +61,10 @@ cameras:
   - {name: stereo, kind: stereo, model: {width: 64, height: 48, fx: 50, fy: 50, cx: 31.5, cy: 23.5, baseline: 0.12}}
 """
 BARE = re.sub(r"poses:\n(  .*\n)+", "", FURNISHED)  # no named poses
+# 1.6 x 1.6 m: room to start (0.45 m clear) but not for targets 1.5 m apart facing surfaces 1-5 m away
+CUPBOARD = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [1.6, 0], [1.6, 1.6], [0, 1.6]], closed: true, "
+                  "height: 2.4}]\n", BARE)
+CUPBOARD = re.sub(r"(boxes|pillars): .*\n", "", CUPBOARD)
 
 
 def test_random_starts_are_clear_reachable_and_drawn_from_the_seed_alone(world_file):
@@ -69,6 +86,62 @@ def test_random_starts_are_clear_reachable_and_drawn_from_the_seed_alone(world_f
                                      "[0, 0.8]], closed: true, height: 2}]\n", "cupboard.yaml"))
     with pytest.raises(ValueError, match="no reachable place 0.45 m clear"):
         random_starts(cupboard, 1, seed=0)
+
+
+def _centre_ray(world, scene: Scene, pose: Pose2D) -> float:
+    """Distance along the front camera's optical axis to the nearest surface above the camera,
+    cast here with the scene's own ray casting (not through the code under test)."""
+    where = camera_pose(world.camera("front"), world.ptu, pose)
+    distance, index = scene.cast_columns(where.eye, np.array([where.psi]))
+    return float(np.min(np.where(scene.heights[index] > where.eye[2], distance[0], np.inf)))
+
+
+@pytest.mark.parametrize("name", ["bare", "lab"])
+def test_placed_targets_are_free_reachable_apart_and_face_surfaces_in_range(world_file, name):
+    world = load_world(str(world_file(BARE)) if name == "bare" else "lab")
+    targets = place_targets(world, 4, seed=3)
+    assert list(targets) == ["t1", "t2", "t3", "t4"]
+    assert targets == place_targets(world, 4, seed=3)  # from the seed alone
+    assert place_targets(world, 2, seed=3) == dict(list(targets.items())[:2])  # the first ones do not depend on N
+    assert place_targets(world, 4, seed=4) != targets
+    scene, grid, rays = Scene(world), reachable_grid(world), camera_rays(world)
+    for pose in targets.values():
+        assert scene.clearance(pose.x, pose.y) >= START_CLEARANCE
+        row, col, _ = grid.cells_of([pose.x, pose.y])
+        assert grid.reachable[row[0], col[0]]
+        assert 1.0 <= _centre_ray(world, scene, pose) <= 5.0
+        view = camera_view(scene, world, pose, rays)
+        assert view.within(1.0, 5.0) and len(set(view.surfaces)) >= 2  # never one flat wall alone
+    poses = list(targets.values())
+    assert min(a.distance_to(b) for i, a in enumerate(poses) for b in poses[i + 1:]) >= 1.5
+    # across seeds the targets spread over the room (not one favourite spot)
+    spread = [p for seed in range(5) for p in place_targets(world, 4, seed).values()]
+    xmin, _, xmax, _ = world.bounds()
+    span = xmax - xmin
+    assert min(p.x for p in spread) < xmin + 0.4 * span and max(p.x for p in spread) > xmax - 0.4 * span
+
+
+def test_no_room_for_targets_is_said(world_file):
+    cupboard = load_world(str(world_file(CUPBOARD, "cupboard.yaml")))
+    random_starts(cupboard, 1, seed=0)  # room to start from...
+    with pytest.raises(ValueError, match="room for [01] target\\(s\\), not 2: reachable, 0.45 m clear, 1.5 m apart"):
+        place_targets(cupboard, 2, seed=0)  # ...but not for two targets
+
+
+def test_placed_targets_go_into_a_copy_of_the_world(world_file, tmp_path):
+    path = str(world_file(BARE))
+    loaded = load_world(path)
+    settings = check_options(path, {})
+    targets = seed_targets(path, loaded, settings, 2, tmp_path / "eval")
+    assert targets.world == str(tmp_path / "eval" / "seeds" / "world_s0002" / "world.yaml")
+    assert targets.poses == place_targets(loaded, 4, 2)
+    copy = load_world(targets.world)
+    assert copy.name == "furnished" and copy.walls == loaded.walls and copy.start == loaded.start
+    for name, pose in targets.poses.items():  # named poses of the copy: bearings sim snapshot --pose t1
+        assert (copy.poses[name].x, copy.poses[name].y) == pytest.approx((pose.x, pose.y))
+        assert math.degrees(copy.poses[name].theta) == pytest.approx(math.degrees(pose.theta))
+    named = str(world_file(FURNISHED, "furnished.yaml"))
+    assert seed_targets(named, load_world(named), check_options(named, {}), 2, tmp_path / "eval").world == named
 
 
 def test_the_true_pose_at_a_time_is_exact_in_a_stop_and_interpolated_elsewhere():
@@ -164,7 +237,8 @@ def test_the_summary_from_hand_made_runs():
         {"episode": "goto", "seed": 1, "number": 0, "goal": "a", "status": "FAILURE", "reason": "lost",
          "reached": False, "error_m": 1.5, "error_deg": 40.0, "sim_time_s": 300.0, "wall_time_s": 30.0},
     ]
-    figures = summarise("w", settings, learns, gotos)
+    figures = summarise("w", settings, learns, gotos, {0: {"a": Pose2D(1, 2, math.radians(90))}})
+    assert figures["targets.source"] == "named poses" and figures["targets.poses"] == {"0": {"a": [1, 2, 90]}}
     assert figures["targets.found"] == 3 and figures["targets.total"] == 4 and figures["targets.within"] == 2
     assert figures["targets.position_error_worst_m"] == 0.3
     assert figures["targets.position_error_mean_m"] == pytest.approx(0.15)
@@ -179,6 +253,10 @@ def test_the_summary_from_hand_made_runs():
     table = format_table(figures)
     assert "targets found 3 of 4" in table and "goto reached 1 of 3 run (4 planned" in table
     assert "seed 0 goto 1 to b: ERROR: killed by SIGKILL" in table
+    placed = format_table(summarise("w", Settings(("t1", "t2"), 0, PLACED), learns, [],
+                                    {1: {"t1": Pose2D(1.5, 2.25, 0.0), "t2": Pose2D(4.0, 1.0, math.pi)}}))
+    assert "targets t1, t2 (placed)" in placed
+    assert "seed 1 placed targets: t1 (1.5, 2.25, 0 deg), t2 (4, 1, 180 deg)" in placed
     empty = summarise("w", settings, learns[1:], [])
     assert empty["goto.reached_rate"] is None and empty["goto.error_worst_m"] is None
     assert "goto reached 0 of 0 run" in format_table(empty)
@@ -198,19 +276,41 @@ def test_targets_and_options_are_checked_against_the_world(world_file):
                            ({"starts": "-1"}, "0 to 1000")]:
         with pytest.raises(ValueError, match=message):
             check_options(path, extra)
+    assert check_options(path, {"targets": "3"}) == Settings(("t1", "t2", "t3"), 5, PLACED)  # a count: placed
     check_world(path)
-    for text, message in [(BARE, "0 named pose.*none.*at least 2"),
-                          (FURNISHED.replace("name: stereo", "name: left"), "no stereo \\(stereo\\) camera")]:
-        with pytest.raises(ValueError, match=message):
-            check_world(str(world_file(text, "other.yaml")))
+    with pytest.raises(ValueError, match="no stereo \\(stereo\\) camera"):
+        check_world(str(world_file(FURNISHED.replace("name: stereo", "name: left"), "other.yaml")))
 
 
-def test_a_world_without_named_poses_exits_2_saying_so(world_file, capsys):
-    assert main(["eval", "roadmap", "--world", str(world_file(BARE))]) == 2
+def test_a_world_without_named_poses_gets_placed_targets(world_file):
+    bare = str(world_file(BARE, "bare.yaml"))
+    assert check_world(bare).poses == {}  # accepted: not refused any more
+    assert check_options(bare, {}) == Settings(("t1", "t2", "t3", "t4"), 5, PLACED)
+    assert check_options(bare, {"targets": "5", "starts": "0"}) == Settings(("t1", "t2", "t3", "t4", "t5"), 0, PLACED)
+    twelve = tuple(f"t{k}" for k in range(1, 13))  # a count places targets in a world with named poses too
+    assert check_options("lab", {"targets": "12"}) == Settings(twelve, 5, PLACED)
+    # a world with one usable named pose: placed too (one target is no roadmap)
+    single = str(world_file(FURNISHED.replace("  q: {x: 5.0, y: 0.8, theta_deg: 90}\n", ""), "single.yaml"))
+    assert check_options(single, {}).source == PLACED
+
+
+@pytest.mark.parametrize(("option", "message"), [
+    ("targets=1", "targets: a count must be 2 to 12, got 1"),
+    ("targets=13", "targets: a count must be 2 to 12, got 13"),
+    ("targets=abc", "targets: world 'furnished' has no named pose 'abc' (its named poses: none)"),
+    ("targets=p,nowhere", "no named pose 'nowhere'"),
+])
+def test_bad_targets_exit_2_with_one_line(world_file, capsys, option, message):
+    world = world_file(FURNISHED if "nowhere" in option else BARE)
+    assert main(["eval", "roadmap", "--world", str(world), "--option", option]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "has 0 named pose(s)" in err and "Traceback" not in err
-    assert main(["eval", "roadmap", "--world", str(world_file(FURNISHED)), "--option", "targets=p,nowhere"]) == 2
-    assert "no named pose 'nowhere'" in capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and message in err and "Traceback" not in err
+
+
+def test_a_world_without_room_for_targets_exits_2(world_file, capsys):
+    assert main(["eval", "roadmap", "--world", str(world_file(CUPBOARD, "cupboard.yaml"))]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "has room for" in err and "not 4" in err
 
 
 def test_the_evaluation_in_the_small_room(world_file, tmp_path, capsys):
