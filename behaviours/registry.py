@@ -37,7 +37,8 @@ Kind = Literal["action", "condition", "decorator", "composite"]
 KINDS: tuple[Kind, ...] = ("action", "condition", "decorator", "composite")
 ENTRY_POINT_GROUP = "bearings.behaviours"
 BUILTIN_MODULES = ("behaviours.control", "behaviours.composites", "behaviours.decorators", "behaviours.motion",
-                   "behaviours.wait", "behaviours.conditions", "behaviours.perceive")
+                   "behaviours.wait", "behaviours.conditions", "behaviours.perceive", "behaviours.localise",
+                   "behaviours.exploration", "behaviours.follow_path", "behaviours.gaze")
 _MARK = "__bearings_node_type__"
 
 

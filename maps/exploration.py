@@ -547,15 +547,34 @@ def scan(
     return edges, np.minimum(np.minimum(ranges, params.explore_range), far / np.cos(centre))
 
 
+def observation_scan(
+    points_camera: np.ndarray, view: CameraView, params: IntegrationParams = IntegrationParams()
+) -> tuple[np.ndarray, np.ndarray]:
+    """The virtual range scan (:func:`scan`) of one stereo observation, as :func:`integrate_stereo`
+    draws it: for a record of what was seen that can be drawn again elsewhere (:func:`scan_cells`)."""
+    world = np.asarray(points_camera, dtype=np.float64).reshape(-1, 3) @ view.rotation.T + view.eye
+    plan = np.hypot(world[:, 0] - view.eye[0], world[:, 1] - view.eye[1])
+    ok = np.isfinite(world).all(axis=1) & (plan <= params.max_range)
+    return scan(view, world[ok], plan[ok], params)
+
+
 def _scan_mask(
     frame: GridFrame, view: CameraView, world: np.ndarray, plan: np.ndarray, params: IntegrationParams
 ) -> np.ndarray:
     """The cells (bool) seen as free floor: between the footprint's near edge and each bin's range."""
+    if len(world) == 0:
+        return np.zeros(frame.shape, dtype=bool)
+    edges, ranges = scan(view, world, plan, params)
+    return scan_cells(frame, view, edges, ranges)
+
+
+def scan_cells(frame: GridFrame, view: CameraView, edges: np.ndarray, ranges: np.ndarray) -> np.ndarray:
+    """The cells (bool) a scan (:func:`scan`) saw as free floor from ``view``: between the footprint's
+    near edge and each bin's range."""
     seen = np.zeros(frame.shape, dtype=np.uint8)
     direction, near, _ = footprint(view)
-    if not math.isfinite(near) or len(world) == 0:
+    if not math.isfinite(near):
         return seen.astype(bool)
-    edges, ranges = scan(view, world, plan, params)
     reach = near / np.cos(edges)  # the image's bottom row: a line on the floor across the axis
     c, s = np.cos(edges), np.sin(edges)
     units = np.column_stack((c * direction[0] - s * direction[1], s * direction[0] + c * direction[1]))

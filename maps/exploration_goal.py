@@ -34,6 +34,15 @@ Choices where the paper is vague:
   does not hold the robot forever. Spent points do not count for "a point has d > K" either.
 - Selection on a map with no explored free cell raises: mark the robot's footprint first
   (:func:`maps.exploration.mark_traversed`), otherwise the first call would be "done".
+- Selection is repeated as the map grows; two nearly equal points would make the robot dither
+  between them. With ``hysteresis`` > 0 the ``current`` goal's point is kept while its attractive
+  power is within that of the best (in frontier mode: its border point, while its travel cost is
+  within that of the closest).
+- Border points near ``avoid`` targets (ones the robot reached or gave up on without the unknown
+  beyond them becoming seen: under furniture, a jamb too close to the cameras' near edge) are no
+  candidates; when only such borders are left, no border is reachable.
+- ``closest_frontier``: frontier mode always: the closest reachable border point (Yamauchi's
+  frontier exploration, the evaluation's baseline; explore_lite also weighs a frontier's size).
 """
 
 from __future__ import annotations
@@ -67,12 +76,17 @@ class GoalParams:
     margin: float = 0.0  # m: steps with less clearance than robot_radius + margin cost more...
     penalty: float = 0.0  # ...up to (1 + penalty) times their length (see maps.exploration.travel_cost)
     patience: int = 1  # selections in a row without a reachable border before DONE (1: the paper)
+    hysteresis: float = 0.0  # m: keep the current goal while it is this close to the best (see the docstring)
+    avoid_radius: float = 0.4  # m: border points this close to an avoided target are no candidates
+    closest_frontier: bool = False  # always the closest reachable border (the baseline), never eq. 1
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.eta <= 0.5:
             raise ValueError(f"eta must be in [0, 0.5] (eq. 1), got {self.eta}")
-        if min(self.k, self.robot_radius, self.min_frontier, self.margin, self.penalty) < 0.0:
-            raise ValueError("k, robot_radius, min_frontier, margin and penalty must not be negative")
+        if min(self.k, self.robot_radius, self.min_frontier, self.margin, self.penalty, self.hysteresis,
+               self.avoid_radius) < 0.0:
+            raise ValueError("k, robot_radius, min_frontier, margin, penalty, hysteresis and avoid_radius "
+                             "must not be negative")
         if self.patience < 1:
             raise ValueError(f"patience must be at least 1, got {self.patience}")
 
@@ -143,12 +157,18 @@ def attractive_power(distance: np.ndarray, cost: np.ndarray, eta: float) -> np.n
     return np.asarray(distance, dtype=np.float64) - eta * np.asarray(cost, dtype=np.float64)  # eq. 1
 
 
-def candidates(m: ExplorationMap, robot: tuple[float, float], params: GoalParams = GoalParams()) -> Candidates:
-    """Reachable border points, and d, P_b and A_P (eq. 1) of every map point, seen from ``robot``."""
+def candidates(
+    m: ExplorationMap, robot: tuple[float, float], params: GoalParams = GoalParams(), avoid: np.ndarray | None = None
+) -> Candidates:
+    """Reachable border points (none within ``avoid_radius`` of an ``avoid`` point, K x 2), and d, P_b
+    and A_P (eq. 1) of every map point, seen from ``robot``."""
     travel = travel_cost(m, robot, params.robot_radius, margin=params.margin, penalty=params.penalty)
     min_cells = max(1, int(math.ceil(params.min_frontier / m.frame.resolution)))
     rows, cols = np.nonzero(borders(m, min_cells) & np.isfinite(travel.cost))
     border = m.frame.centre_of(rows, cols)
+    if avoid is not None and len(avoid) and len(border):
+        keep = cKDTree(np.asarray(avoid, dtype=np.float64).reshape(-1, 2)).query(border)[0] > params.avoid_radius
+        rows, cols, border = rows[keep], cols[keep], border[keep]
     border_cost = travel.cost[rows, cols]
     n = len(m.points)
     if len(border) == 0:
@@ -160,31 +180,62 @@ def candidates(m: ExplorationMap, robot: tuple[float, float], params: GoalParams
 
 
 def select_goal(
-    switch: ModeSwitch, m: ExplorationMap, robot: tuple[float, float], params: GoalParams = GoalParams()
+    switch: ModeSwitch,
+    m: ExplorationMap,
+    robot: tuple[float, float],
+    params: GoalParams = GoalParams(),
+    *,
+    current: Goal | None = None,
+    avoid: np.ndarray | None = None,
 ) -> tuple[ModeSwitch, Goal | None]:
     """The next mode and goal for a robot at ``robot`` (odometry x, y).
 
-    No goal: DONE, or (with ``patience`` > 1) no border reachable yet again: look around, retry.
+    ``current``: the goal being driven to (kept within ``hysteresis``); ``avoid``: targets (K x 2)
+    whose border points are no candidates. No goal: DONE, or (with ``patience`` > 1) no border
+    reachable yet again: look around, retry.
     """
     if not np.any(m.cells == Cell.FREE):
         raise ValueError("the exploration map has no explored free cell: mark the robot's footprint first")
     if switch.mode is Mode.DONE:
         return switch, None
-    found = candidates(m, robot, params)
+    found = candidates(m, robot, params, avoid)
     eligible = found.distance > params.k
     if switch.spent:
         eligible[np.fromiter(switch.spent, dtype=np.int64)] = False
+    if params.closest_frontier:
+        eligible[:] = False
     reachable = len(found.border) > 0
     switch = switch.next(point_beyond_k=bool(eligible.any()), border_reachable=reachable, patience=params.patience)
     if switch.mode is Mode.DONE or not reachable:
         return switch, None
     if switch.mode is Mode.ATTRACTION:
-        point = int(np.argmax(np.where(eligible, found.power, -np.inf)))
+        point = _best_point(found, eligible, current, params.hysteresis)
         b = int(found.nearest[point])
         distance, power = float(found.distance[point]), float(found.power[point])
     else:
-        point, b = None, int(np.argmin(found.border_cost))
+        point, b = None, _closest_border(found, current, params.hysteresis, m.frame.resolution)
         distance, power = 0.0, math.nan
     target = (float(found.border[b, 0]), float(found.border[b, 1]))
     goal = Goal(switch.mode, target, point, distance, float(found.border_cost[b]), power, found.travel.path_to(target))
     return switch, goal
+
+
+def _best_point(found: Candidates, eligible: np.ndarray, current: Goal | None, hysteresis: float) -> int:
+    """The eligible point of the highest attractive power, or the current goal's within ``hysteresis``."""
+    best = int(np.argmax(np.where(eligible, found.power, -np.inf)))
+    keep = current.point if current is not None and current.mode is Mode.ATTRACTION else None
+    if keep is not None and keep < len(eligible) and eligible[keep]:
+        return int(keep) if found.power[keep] >= found.power[best] - hysteresis else best
+    return best
+
+
+def _closest_border(found: Candidates, current: Goal | None, hysteresis: float, resolution: float) -> int:
+    """The reachable border point of the least travel cost, or the current frontier target within ``hysteresis``."""
+    best = int(np.argmin(found.border_cost))
+    if current is None or current.mode is not Mode.FRONTIER or hysteresis <= 0.0:
+        return best
+    gap = np.hypot(*(found.border - np.asarray(current.target)).T)
+    near = int(np.argmin(gap))
+    if gap[near] <= 1.5 * resolution and found.border_cost[near] <= found.border_cost[best] + hysteresis:
+        return near
+    return best

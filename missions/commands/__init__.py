@@ -15,4 +15,5 @@ COMMANDS = (
     "missions.commands.doctor",
     "missions.commands.map",
     "missions.commands.sweep",
+    "missions.commands.eval",
 )

@@ -1,0 +1,105 @@
+"""``bearings eval AREA --world NAME|PATH --seeds N --json``: an evaluation's named figures.
+
+The area's episodes run through the sweep runner (``missions.sweep.run_sweep``) on a local process
+pool (``--workers``) or a Dask cluster (``--cluster``); ``-o DIR`` keeps the sweep's folder (the
+table, every run's report) and ``--resume`` continues it. The areas are the modules of
+:data:`missions.eval.AREAS`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import importlib
+import json
+import sys
+import tempfile
+from collections.abc import Iterator
+from concurrent.futures import Executor
+from pathlib import Path
+
+from maps.store import InputError
+from missions.commands.common import EXIT_FAILURE, EXIT_OK, fail, print_input_error
+from missions.eval import AREAS, EvalOptions
+from missions.sweep import SweepError, SweepInputError, SweepInterrupted, cluster_executor, local_executor
+from missions.sweep.sweeper import progress_stream
+
+MAX_SEEDS = 10_000
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    parser = sub.add_parser(
+        "eval", help="evaluate an area (exploration) in a simulated world over seeds and print named figures",
+        description="Run an area's evaluation episodes through the sweep runner and print one JSON object of "
+                    "named figures (--json) or a table. Works on any world file the simulator reads.",
+    )
+    parser.add_argument("area", choices=sorted(AREAS), help="what to evaluate")
+    parser.add_argument("--world", required=True, metavar="NAME|PATH", help="a shipped world or a world file")
+    parser.add_argument("--seeds", type=int, default=1, metavar="N", help="seeds 0 to N-1 (default 1)")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the cores here)")
+    where.add_argument("--cluster", metavar="ADDRESS", help="run the episodes on this Dask scheduler")
+    parser.add_argument("--timeout", type=float, metavar="S", help="kill an episode after S s of wall time")
+    parser.add_argument("--max-time", type=float, metavar="S", help="each episode's --max-time (simulated s)")
+    parser.add_argument("-o", "--output", type=Path, metavar="DIR", help="keep the sweep's results here")
+    parser.add_argument("--resume", action="store_true", help="with -o: reuse the episodes DIR already has")
+    parser.add_argument("--progress", action="store_true", help="progress on stderr even when not a terminal")
+    parser.add_argument("--json", action="store_true", help="print one JSON object (default: a table)")
+    parser.set_defaults(func=run)
+
+
+@contextlib.contextmanager
+def _executor(args: argparse.Namespace) -> Iterator[Executor]:
+    if args.cluster:
+        with cluster_executor(args.cluster) as executor:
+            yield executor
+    else:
+        executor = local_executor(args.workers)
+        try:
+            yield executor
+        finally:
+            executor.shutdown(wait=True, cancel_futures=True)
+
+
+def _problem(args: argparse.Namespace) -> str | None:
+    if not 1 <= args.seeds <= MAX_SEEDS:
+        return f"--seeds must be 1 to {MAX_SEEDS}, got {args.seeds}"
+    if args.workers is not None and args.workers < 1:
+        return f"--workers must be at least 1, got {args.workers}"
+    for name in ("timeout", "max_time"):
+        value = getattr(args, name)
+        if value is not None and not value > 0:
+            return f"--{name.replace('_', '-')} must be positive, got {value:g}"
+    if args.resume and args.output is None:
+        return "--resume needs -o DIR"
+    if args.output is not None and not args.resume and (args.output / "results.jsonl").exists():
+        return f"{args.output} already has results: --resume continues them, or choose another folder"
+    return None
+
+
+def run(args: argparse.Namespace) -> int:
+    problem = _problem(args)
+    if problem:
+        return fail("eval", problem)
+    module = importlib.import_module(AREAS[args.area])
+    try:
+        module.check_world(args.world)
+    except InputError as exc:
+        return print_input_error(exc)
+    except ValueError as exc:
+        return fail("eval", str(exc))
+    with contextlib.ExitStack() as stack:
+        folder = args.output or Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="bearings-eval-")))
+        try:
+            executor = stack.enter_context(_executor(args))
+            options = EvalOptions(args.world, list(range(args.seeds)), executor, folder, args.timeout,
+                                  args.max_time, progress_stream(args.progress))
+            figures = module.run(options, resume=args.resume)
+        except SweepInputError as exc:
+            return fail("eval", str(exc))
+        except (SweepInterrupted, SweepError) as exc:
+            print(f"bearings eval: {exc}", file=sys.stderr)
+            return EXIT_FAILURE
+    figures = {"area": args.area, **figures}
+    print(json.dumps(figures, indent=2) if args.json else module.format_table(figures))
+    return EXIT_OK
