@@ -71,6 +71,23 @@ def stereo_points(depth: np.ndarray, rig: StereoRig, step: int) -> tuple[np.ndar
     return bearings * (z[ok] / bearings[:, 0])[:, None], uv
 
 
+BELOW_FLOOR = 0.2  # m: stereo points this far below the floor are wrong matches, dropped
+
+
+def drop_jumps(depth: np.ndarray, max_jump: float, radius: int = 3) -> np.ndarray:
+    """The depth map without the pixels within ``radius`` of a depth jump larger than ``max_jump``
+    (relative): a semi-global matcher smears depth across occluding edges (a door jamb in front of
+    the room behind), streaks that would otherwise become obstacles on the floor between the two."""
+    if max_jump <= 0.0:
+        return depth
+    kernel = np.ones((2 * radius + 1, 2 * radius + 1), np.uint8)
+    ok = np.isfinite(depth)
+    high = cv2.dilate(np.where(ok, depth, 0.0).astype(np.float32), kernel)
+    low = cv2.erode(np.where(ok, depth, np.finfo(np.float32).max).astype(np.float32), kernel)
+    keep = ok & (high - low <= max_jump * low)
+    return np.where(keep, depth, np.nan).astype(np.float32)
+
+
 def halved(rig: StereoRig) -> StereoRig:
     """The rig of images halved by ``cv2.pyrDown`` (pixel centres: ``(u + 0.5) / 2 - 0.5``)."""
     def half(c: PinholeCamera) -> PinholeCamera:
@@ -120,6 +137,9 @@ class MapStereo(BearingsBehaviour):
                   doc="sample the depth every step px (of the full image)"),
         InputPort("levels", int, 1, minimum=0, maximum=3, literal_only=True,
                   doc="match images halved this many times (1: 8x faster, depth within a few cm at 3 m)"),
+        InputPort("max_jump", float, 0.15, minimum=0.0, maximum=10.0, literal_only=True,
+                  doc="depths within 3 px (of the matched image) may differ by this fraction; pixels beside "
+                      "larger jumps are dropped (0: keep all)"),
         InputPort("resolution", float, 0.05, unit="m", minimum=0.01, maximum=0.5, literal_only=True,
                   doc="map cell size"),
         InputPort("explore_range", float, 3.0, unit="m", minimum=0.5, maximum=20.0, literal_only=True,
@@ -191,9 +211,12 @@ class MapStereo(BearingsBehaviour):
             left, right, small = cv2.pyrDown(left), cv2.pyrDown(right), halved(small)
         scale = 2**levels
         depth = dense_depth(left, right, small, num_disparities=-(-int(self.get_input("num_disparities")) // scale))
+        depth = drop_jumps(depth, float(self.get_input("max_jump")))
         points, uv = stereo_points(depth, small, max(1, int(self.get_input("step")) // scale))
         uv = (uv + 0.5) * scale - 0.5  # full-image pixels: image neighbours as integrate_stereo expects
         view = self.head.view(pose, ptu.pan, ptu.tilt)
+        above = points @ view.rotation[2] + view.eye[2] >= -BELOW_FLOOR  # the floor is flat: lower is a wrong match
+        points, uv = points[above], uv[above]
         self.map = integrate_stereo(self.map, points, uv, view, self._params)
         _, ranges = observation_scan(points, view, self._params)
         self._scan_bins = len(ranges)
@@ -247,13 +270,17 @@ class SelectGoalPoint(BearingsBehaviour):
     mode always, the evaluation's baseline). The goal is chosen again every ``reselect`` seconds
     (the map grows as the robot drives; the current goal is kept while within ``hysteresis`` of the
     best) and when the robot is within ``reach`` of it (its point is then spent, its border point
-    avoided).
+    avoided for good: the unknown beyond it cannot be seen from there). Points seen in fewer than
+    ``min_sightings`` observations do not attract (stray stereo matches).
 
     RUNNING while there is a goal (written to ``goal``; path following and the gaze read it);
     SUCCESS when no border has been reachable ``patience`` selections in a row (DONE); FAILURE
     when no border is reachable but patience is not used up: look around and tick it again (a
-    recovery). A goal abandoned because the branch was halted (path following failed) is spent
-    and avoided too. The mode, strikes, spent points and avoided targets outlive re-entries.
+    recovery). A goal abandoned because the branch was halted (path following failed: a path
+    blocked by what the cameras saw on the way) is spent and its border point avoided; but before
+    a selection finds no border, the abandoned border points get a second chance (the map may have
+    changed since: a doorway's stray obstacles cleared); one abandoned again is avoided for good.
+    The mode, strikes, spent points and avoided targets outlive re-entries.
     """
 
     PORTS = (
@@ -278,6 +305,10 @@ class SelectGoalPoint(BearingsBehaviour):
                   doc="choose again this often while driving"),
         InputPort("reach", float, 0.45, unit="m", minimum=0.05, maximum=5.0, literal_only=True,
                   doc="a goal this close is reached"),
+        InputPort("min_sightings", int, 2, minimum=1, maximum=1000, literal_only=True,
+                  doc="points seen in fewer observations do not attract"),
+        InputPort("point_clearance", float, 0.3, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
+                  doc="points whose floor projection is this close to an obstacle do not attract"),
         MAP,
         POSE,
         OutputPort("goal", Goal, "/map/exploration_goal", doc="the goal: border point, path, mode (None: none)"),
@@ -291,10 +322,14 @@ class SelectGoalPoint(BearingsBehaviour):
             margin=float(self.get_input("margin")), penalty=float(self.get_input("penalty")),
             patience=int(self.get_input("patience")), hysteresis=float(self.get_input("hysteresis")),
             closest_frontier=self.get_input("strategy") == "closest_frontier",
+            min_sightings=int(self.get_input("min_sightings")),
+            point_clearance=float(self.get_input("point_clearance")),
         )  # fmt: skip
         self.switch = ModeSwitch()
         self.goal: Goal | None = None
-        self.avoid: list[tuple[float, float]] = []
+        self.avoid: list[tuple[float, float]] = []  # abandoned: avoided until a second chance
+        self.forgiven: list[tuple[float, float]] = []  # had their second chance
+        self.given_up: list[tuple[float, float]] = []  # reached (or abandoned twice): avoided for good
         self.selected_at = -math.inf
         self.goals: list[list[Any]] = []
         self.mode_switches: list[list[Any]] = []
@@ -319,8 +354,14 @@ class SelectGoalPoint(BearingsBehaviour):
         if reached and goal is not None:
             self.reached += 1
             self.switch = self.switch.spend(goal.point)
-            self.avoid.append(goal.target)
+            self.given_up.append(goal.target)
+        before = self.switch
         self._select(m, pose, None if reached else goal)
+        if self.goal is None and self.avoid:  # a second chance for the abandoned border points
+            self.forgiven += self.avoid
+            self.avoid = []
+            self.switch = before
+            self._select(m, pose, None)
         if self.switch.mode is Mode.DONE:
             self.feedback_message = "done: no border is reachable"
             return Status.SUCCESS
@@ -334,7 +375,7 @@ class SelectGoalPoint(BearingsBehaviour):
 
     def _select(self, m: ExplorationMap, pose: Pose2D, current: Goal | None) -> None:
         before = self.switch.mode
-        avoid = np.array(self.avoid) if self.avoid else None
+        avoid = np.array(self.avoid + self.given_up) if self.avoid or self.given_up else None
         self.switch, goal = select_goal(self.switch, m, (pose.x, pose.y), self.params, current=current, avoid=avoid)
         self.selections += 1
         self.selected_at = self.now()
@@ -353,7 +394,9 @@ class SelectGoalPoint(BearingsBehaviour):
         if new_status == Status.INVALID and self.goal is not None:  # halted: the goal could not be followed
             self.abandoned += 1
             self.switch = self.switch.spend(self.goal.point)
-            self.avoid.append(self.goal.target)
+            target = self.goal.target
+            again = any(math.dist(target, f) <= self.params.avoid_radius for f in self.forgiven)
+            (self.given_up if again else self.avoid).append(target)
             self.goal = None
             self.set_output("goal", None)
 

@@ -15,13 +15,17 @@ disparities) and may be looking sideways:
   (:func:`maps.exploration.travel_cost`), and FAILURE when the target cannot be reached any more.
 - **Motion**: a forward step that would bring an obstacle cell within ``robot_radius +
   clearance`` of the disc's centre, nearer than now, is not taken (the robot turns instead).
-- **Seen floor only**: the robot does not drive its disc onto floor it has not seen: the forward
-  speed is limited to stop before the first point of the path ahead whose disc covers an unknown
-  cell (beyond the disc it covers now). That point goes to ``unseen_ahead`` (None when the next
-  ``guard`` metres are seen), for the gaze to look at, since the cameras may be watching
-  something else (:class:`behaviours.gaze.WatchInterestEdges`). The goal itself is a border
-  point, next to the unknown: the robot stops about a radius before it unless the cameras see
-  beyond it first.
+- **Seen floor ahead only**: the robot does not drive *into* floor it has not seen: the forward
+  speed is limited to stop before the first point of the path ahead where the front of its disc
+  (within ``front`` of the direction of travel) covers an unknown cell (beyond the disc it covers
+  now). Those cells go to ``unseen_ahead`` (None when the next ``guard`` metres are seen), for the
+  gaze to look at, since the cameras may be watching something else
+  (:class:`behaviours.gaze.WatchInterestEdges`). Unknown floor *beside* the path does not hold the
+  robot: within ~0.5 m of the lens the cameras see nothing, so floor beside a path along a border
+  would never become seen from it (tried: the robot stalled at every border it drove along); a
+  tall obstacle there would have been seen ahead, from farther away, by cameras looking where the
+  robot goes. The goal itself is a border point, next to the unknown: the robot stops about a
+  radius before it unless the cameras see beyond it first.
 - **Progress**: no metre of path gained for ``stuck_time`` seconds (a stop before unseen floor the
   cameras cannot see from here: nearer than their ~0.5 m blind zone): FAILURE, so that a recovery
   looks around and the goal is chosen again.
@@ -124,6 +128,8 @@ class FollowPath(BearingsBehaviour):
                   doc="how much of the path ahead must be seen floor before the cameras may look elsewhere"),
         InputPort("stuck_time", float, 8.0, unit="s", minimum=0.5, maximum=600.0, literal_only=True,
                   doc="give the goal up after this long without progress"),
+        InputPort("front", float, 60.0, unit="deg", minimum=0.0, maximum=180.0, literal_only=True,
+                  doc="unseen floor within this of the direction of travel holds the robot (180: the whole disc)"),
         GOAL,
         MAP,
         POSE,
@@ -260,24 +266,33 @@ class FollowPath(BearingsBehaviour):
         return then >= room or then >= nearest_obstacle(m, np.array([pose.x, pose.y]), room + step)
 
     def _seen_distance(self, m: ExplorationMap, here: np.ndarray) -> float:
-        """Distance to the first point of the path ahead (within ``guard``) whose disc covers an unknown
-        cell that the robot's disc does not cover now (inf: none); that point goes to ``unseen_ahead``.
-        Unknown cells under the robot already (at the start, after a recovery) do not hold it."""
+        """Distance to the first point of the path ahead (within ``guard``) where the front of the disc
+        (within ``front`` of the direction of travel) covers an unknown cell that the disc does not
+        cover now (inf: none). The unknown cells found there go to ``unseen_ahead`` (their centroid).
+        Unknown cells under the robot already (at the start, after a recovery) do not hold it, nor
+        unknown floor beside the path: the cameras cannot see within ~0.5 m of the lens, so the floor
+        beside a path along a border would never become seen from it."""
         radius = float(self.get_input("robot_radius"))
         ahead = self.path[self.index :]
         along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ahead, axis=0).T))))
         offsets = _disc_offsets(m, radius + m.frame.resolution)
-        for point, s in zip(ahead, along, strict=True):
+        cos_front = math.cos(math.radians(float(self.get_input("front"))))
+        for k, (point, s) in enumerate(zip(ahead, along, strict=True)):
             if s > float(self.get_input("guard")):
                 break
             rows, cols = (v[0] + offsets[:, i] for i, v in enumerate(m.frame.cell_of(point)))
             centres = m.frame.centre_of(rows, cols)
-            new = (np.hypot(*(centres - point).T) <= radius) & (np.hypot(*(centres - here).T) > radius)
+            heading = ahead[min(k + 1, len(ahead) - 1)] - ahead[max(k - 1, 0)]
+            heading = heading / max(float(np.hypot(*heading)), 1e-9)
+            rel = centres - point
+            dist = np.hypot(*rel.T)
+            new = (dist <= radius) & (np.hypot(*(centres - here).T) > radius) & (rel @ heading >= cos_front * dist)
             inside = m.frame.inside(rows, cols)
             unknown = ~inside
             unknown[inside] = m.cells[rows[inside], cols[inside]] == Cell.UNKNOWN
             if np.any(unknown & new):
-                self.set_output("unseen_ahead", Pose2D(float(point[0]), float(point[1])))
+                centroid = centres[unknown & new].mean(axis=0)
+                self.set_output("unseen_ahead", Pose2D(float(centroid[0]), float(centroid[1])))
                 return float(np.hypot(*(point - here)))
         return math.inf
 

@@ -133,6 +133,8 @@ class WatchInterestEdges(BearingsBehaviour):
         PTU_POSITION,
         CAMERA_POSITION,
         InputPort("turn_rate", float, 0.0, unit="rad/s", doc="the robot's commanded turn rate (eq. 4)"),
+        InputPort("near_floor", float, 0.8, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
+                  doc="unseen floor nearer than this to the pan axis is looked at from this far"),
         InputPort("unseen_ahead", Pose2D, None,
                   doc="unseen floor on the path ahead ({/robot/unseen_ahead}): look there first"),
         MAP,
@@ -160,11 +162,12 @@ class WatchInterestEdges(BearingsBehaviour):
         self.look_ahead_ticks = 0
 
     def _look_at(self, pose: Pose2D, point: Pose2D) -> tuple[float, float]:
-        """Pan and tilt that centre a floor point in the image."""
+        """Pan and tilt that centre a floor point in the image, or the nearest floor the cameras can
+        see in its direction (``near_floor`` from the pan axis: nearer, stereo finds no depth)."""
         head = self.params.head
         axis = head.axis_xy(pose)
         pan = float(pan_to_point(pose, axis, np.array([point.x, point.y]))[0])  # eq. 3
-        distance = math.hypot(point.x - axis[0], point.y - axis[1])
+        distance = max(math.hypot(point.x - axis[0], point.y - axis[1]), float(self.get_input("near_floor")))
         return float(np.clip(pan, *self.params.pan_limits)), math.atan2(-head.lens_height, distance)
 
     def update(self) -> Status:

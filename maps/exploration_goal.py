@@ -41,6 +41,15 @@ Choices where the paper is vague:
 - Border points near ``avoid`` targets (ones the robot reached or gave up on without the unknown
   beyond them becoming seen: under furniture, a jamb too close to the cameras' near edge) are no
   candidates; when only such borders are left, no border is reachable.
+- A point seen in fewer than ``min_sightings`` observations has d = 0: a stereo matcher's stray
+  matches (in simulated runs: points metres outside the building, or below the floor)
+  would otherwise be the most attractive points of all, every one a trip.
+- With ``point_clearance`` > 0, a point whose floor projection lies that close to an obstacle cell
+  has d = 0: the upper part of a wall (above the obstacle height, so its cells stay unknown behind
+  the wall line) is not open space beyond the border, and would otherwise pull the robot to the
+  reachable border nearest to it, however far and useless. Points in unknown space away from
+  known obstacles (the floor and walls of a room seen through a door, beyond the explore range)
+  still attract.
 - ``closest_frontier``: frontier mode always: the closest reachable border point (Yamauchi's
   frontier exploration, the evaluation's baseline; explore_lite also weighs a frontier's size).
 """
@@ -54,7 +63,7 @@ from enum import StrEnum
 import numpy as np
 from scipy.spatial import cKDTree
 
-from maps.exploration import Cell, ExplorationMap, TravelCost, borders, travel_cost
+from maps.exploration import Cell, ExplorationMap, TravelCost, borders, clearance, travel_cost
 
 
 class Mode(StrEnum):
@@ -79,14 +88,16 @@ class GoalParams:
     hysteresis: float = 0.0  # m: keep the current goal while it is this close to the best (see the docstring)
     avoid_radius: float = 0.4  # m: border points this close to an avoided target are no candidates
     closest_frontier: bool = False  # always the closest reachable border (the baseline), never eq. 1
+    min_sightings: int = 1  # points seen in fewer observations do not attract (stray stereo matches)
+    point_clearance: float = 0.0  # m: points whose floor projection is this close to an obstacle cell do not attract
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.eta <= 0.5:
             raise ValueError(f"eta must be in [0, 0.5] (eq. 1), got {self.eta}")
         if min(self.k, self.robot_radius, self.min_frontier, self.margin, self.penalty, self.hysteresis,
-               self.avoid_radius) < 0.0:
-            raise ValueError("k, robot_radius, min_frontier, margin, penalty, hysteresis and avoid_radius "
-                             "must not be negative")
+               self.avoid_radius, self.point_clearance) < 0.0:
+            raise ValueError("k, robot_radius, min_frontier, margin, penalty, hysteresis, avoid_radius and "
+                             "point_clearance must not be negative")
         if self.patience < 1:
             raise ValueError(f"patience must be at least 1, got {self.patience}")
 
@@ -174,7 +185,14 @@ def candidates(
     if len(border) == 0:
         return Candidates(border, border_cost, np.full(n, np.inf), np.full(n, -1), np.full(n, -np.inf), travel)
     distance, nearest = cKDTree(border).query(m.points[:, :2]) if n else (np.zeros(0), np.zeros(0, dtype=np.int64))
-    distance = np.where(m.cell_state(m.points[:, :2]) == Cell.UNKNOWN, distance, 0.0)
+    eligible = (m.cell_state(m.points[:, :2]) == Cell.UNKNOWN) & (m.sightings >= params.min_sightings)
+    if params.point_clearance > 0.0 and n:
+        rows, cols = m.frame.cell_of(m.points[:, :2])
+        inside = m.frame.inside(rows, cols)
+        room = np.full(n, np.inf)
+        room[inside] = clearance(m)[rows[inside], cols[inside]]
+        eligible &= room > params.point_clearance
+    distance = np.where(eligible, distance, 0.0)
     power = attractive_power(distance, border_cost[nearest], params.eta)
     return Candidates(border, border_cost, distance, np.asarray(nearest, dtype=np.int64), power, travel)
 

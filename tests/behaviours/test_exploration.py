@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.exploration import MapStereo, SelectGoalPoint, pack_cells, unpack_cells
+from behaviours.exploration import MapStereo, SelectGoalPoint, drop_jumps, pack_cells, unpack_cells
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import PanTiltState
 from drivers.sim.simulation import Simulation
@@ -80,6 +80,19 @@ def test_the_report_has_the_map_and_the_scans(stereo_frame):
     assert section["explored_area_m2"] == pytest.approx(m.explored_area)
 
 
+def test_pixels_beside_a_depth_jump_are_dropped():
+    depth = np.full((20, 30), 2.0, dtype=np.float32)
+    depth[:, 15:] = 5.0  # a jamb at 2 m in front of a wall at 5 m
+    depth[0, 0] = np.nan
+    out = drop_jumps(depth, 0.15, radius=3)
+    dropped = np.flatnonzero(np.isnan(out[10]))
+    assert dropped.tolist() == list(range(12, 18))  # 3 px either side of the edge
+    assert np.isnan(out[0, 0]) and out[10, 5] == 2.0 and out[10, 25] == 5.0
+    gentle = np.tile(np.linspace(2.0, 2.2, 30, dtype=np.float32), (20, 1))  # a floor: 0.7 % a pixel
+    assert np.isfinite(drop_jumps(gentle, 0.15)).all()
+    assert drop_jumps(depth, 0.0) is depth
+
+
 def test_packed_cells_round_trip():
     mask = np.random.default_rng(1).random((7, 13)) > 0.5
     assert np.array_equal(unpack_cells(pack_cells(mask), 7, 13), mask)
@@ -106,7 +119,8 @@ FAR_EAST = [5.0, 1.1, 0.5]  # 1.95 m beyond the gap's border
 
 
 def select(**ports) -> SelectGoalPoint:
-    defaults = dict(robot_radius=0.2, margin=0.0, penalty=0.0, min_frontier=0.1, odometry="{/robot/pose}")
+    defaults = dict(robot_radius=0.2, margin=0.0, penalty=0.0, min_frontier=0.1, min_sightings=1,
+                    odometry="{/robot/pose}")
     return SelectGoalPoint(**{**defaults, **ports})
 
 
@@ -154,6 +168,7 @@ def test_reaching_the_goal_spends_its_point_and_chooses_again():
     assert 0 in harness.behaviour.switch.spent and harness.behaviour.reached == 1
     # the point is spent and the gap's border near the reached target avoided: nothing else is left
     assert goal is None and harness.behaviour.status == Status.FAILURE
+    assert harness.behaviour.given_up == [target]
 
 
 def test_no_reachable_border_fails_until_patience_then_succeeds():
@@ -175,6 +190,19 @@ def test_a_goal_abandoned_by_a_halt_is_avoided():
     harness.halt()  # path following failed: the parallel halts the selection
     assert harness.read(GOAL) is None and harness.behaviour.avoid == [target]
     assert harness.behaviour.abandoned == 1
+
+
+def test_abandoned_border_points_get_a_second_chance_before_done():
+    harness = BehaviourHarness(select(patience=1), blackboard={MAP: explored_room([]), POSE: Pose2D(0.5, 1.0)})
+    harness.tick()
+    first = harness.read(GOAL).target
+    harness.halt()  # abandoned: avoided
+    assert harness.tick() == Status.RUNNING  # nothing else is left: the gap gets its second chance
+    assert harness.read(GOAL).target == pytest.approx(first)
+    assert harness.behaviour.forgiven == [first] and harness.behaviour.avoid == []
+    harness.halt()  # abandoned again: avoided for good
+    assert harness.behaviour.given_up == [first]
+    assert harness.tick() == Status.SUCCESS  # patience 1: done
 
 
 def test_waits_for_the_map():

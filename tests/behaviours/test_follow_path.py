@@ -83,7 +83,7 @@ def test_stops_before_unseen_floor_and_says_where_it_is():
     harness = follow(room(unknown_from=1.5), goal_to(3.0), guard=2.0)
     harness.tick()
     unseen = harness.read("/robot/unseen_ahead")
-    assert unseen is not None and 1.1 < unseen.x < 1.5  # the first disc (radius 0.25) reaching x = 1.5
+    assert unseen is not None and 1.5 < unseen.x < 1.6 and unseen.y == pytest.approx(0.0, abs=0.03)  # the cells
     for _ in range(100):
         harness.tick()
         drive(harness)
@@ -91,6 +91,16 @@ def test_stops_before_unseen_floor_and_says_where_it_is():
     x = harness.read("/robot/odometry").x
     assert 1.0 < x <= 1.525 - 0.25  # the disc never covers an unknown cell (centres from 1.525)
     assert harness.behaviour.blind_stops > 0
+
+
+def test_unseen_floor_beside_the_path_does_not_hold_the_robot():
+    m = room()
+    cells = m.cells.copy()
+    ys = FRAME.centre_of(np.arange(FRAME.rows), np.zeros(FRAME.rows, dtype=int))[:, 1]
+    cells[ys > 0.2, :] = Cell.UNKNOWN  # unknown from 0.2 m left of the path: within the disc's reach
+    harness = follow(ExplorationMap.from_cells(FRAME, cells), goal_to(3.0))
+    harness.tick()
+    assert harness.read("/robot/unseen_ahead") is None and harness.read("/robot/command").v > 0.3
 
 
 def test_gives_up_after_no_progress():

@@ -129,3 +129,46 @@ def test_patience_gives_no_goal_before_done():
 def test_selection_needs_the_robots_footprint_first():
     with pytest.raises(ValueError, match="footprint"):
         select_goal(ModeSwitch(), ExplorationMap.empty(resolution=0.1, half_size=1.0), (0.0, 0.0))
+
+
+def test_points_seen_once_do_not_attract_with_min_sightings():
+    m = explored_strip([P1, P2])
+    m = ExplorationMap(m.frame, m.evidence, m.points, visited=m.visited, sightings=np.array([1, 3], dtype=np.int32))
+    params = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, min_sightings=2)
+    found = candidates(m, ROBOT, params)
+    assert found.distance == pytest.approx([0.0, 1.55])
+    _, goal = select_goal(ModeSwitch(), m, ROBOT, params)
+    assert goal is not None and goal.point == 1
+
+
+def test_the_current_goal_is_kept_within_the_hysteresis():
+    m = explored_strip([P1, P2])  # A_P: P1 1.625, P2 1.45
+    _, best = select_goal(ModeSwitch(), m, ROBOT, NO_RADIUS)
+    assert best is not None and best.point == 0
+    _, current = select_goal(ModeSwitch().spend(0), m, ROBOT, NO_RADIUS)
+    assert current is not None and current.point == 1
+    keep = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, hysteresis=0.2)
+    _, goal = select_goal(ModeSwitch(), m, ROBOT, keep, current=current)
+    assert goal is not None and goal.point == 1  # 1.45 is within 0.2 of 1.625
+    tight = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, hysteresis=0.1)
+    _, goal = select_goal(ModeSwitch(), m, ROBOT, tight, current=current)
+    assert goal is not None and goal.point == 0
+
+
+def test_avoided_targets_are_no_candidates_and_the_baseline_ignores_points():
+    m = explored_strip([P1, P2])
+    found = candidates(m, ROBOT, NO_RADIUS, avoid=np.array([[1.95, 0.55]]))
+    assert np.min(np.hypot(*(found.border - [1.95, 0.55]).T)) > NO_RADIUS.avoid_radius
+    baseline = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, closest_frontier=True)
+    switch, goal = select_goal(ModeSwitch(), m, ROBOT, baseline)
+    assert switch.mode is Mode.FRONTIER and goal is not None and goal.cost == pytest.approx(0.2)
+
+
+def test_points_next_to_obstacles_do_not_attract_with_a_point_clearance():
+    m = explored_strip([[2.15, 0.25, 2.0], [4.0, 0.85, 0.5]], walled=True)  # atop the east wall; farther east
+    cells = m.cells.copy()
+    cells[7:11, 21] = Cell.UNKNOWN  # a gap in the east wall (y 0.6 - 1.0): the strip has a border there
+    m = ExplorationMap.from_cells(m.frame, cells, points=m.points)
+    params = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, point_clearance=0.3)
+    found = candidates(m, ROBOT, params)
+    assert found.distance[0] == 0.0 and found.distance[1] > 1.0
