@@ -124,6 +124,8 @@ def seen_floor(report: dict[str, Any], floor: FloorGrid, robot_radius: float) ->
     curve = []
     for t, kind, item in sorted(events, key=lambda e: (e[0], e[1])):
         if kind == 0:  # the robot's body covers the floor it stands on
+            if disc == 0:
+                continue
             rows, cols, _ = floor.cells_of(trajectory.xy[item])
             cv2.circle(seen, (int(cols[0]), int(rows[0])), disc, 1, -1)
         else:
