@@ -66,12 +66,17 @@ def _disc_offsets(m: ExplorationMap, radius: float) -> np.ndarray:
 
 
 def disc_cells(m: ExplorationMap, centres: np.ndarray, radius: float) -> np.ndarray:
-    """The states (uint8 Cell) of the cells whose centres lie within ``radius`` of any of ``centres``."""
+    """The states (uint8 Cell) of the cells whose centres lie within ``radius`` of any of ``centres``
+    (exactly: a travel-cost path, whose cells have more clearance than the radius, is never found
+    blocked by this)."""
     f = m.frame
-    offsets = _disc_offsets(m, radius)
-    rows, cols = f.cell_of(np.asarray(centres, dtype=np.float64).reshape(-1, 2))
+    points = np.asarray(centres, dtype=np.float64).reshape(-1, 2)
+    offsets = _disc_offsets(m, radius + f.resolution)  # a superset, cut by distance below
+    rows, cols = f.cell_of(points)
     r = (rows[:, None] + offsets[None, :, 0]).ravel()
     c = (cols[:, None] + offsets[None, :, 1]).ravel()
+    near = np.hypot(*(f.centre_of(r, c) - np.repeat(points, len(offsets), axis=0)).T) <= radius
+    r, c = r[near], c[near]
     inside = f.inside(r, c)
     out = np.full(len(r), Cell.UNKNOWN, dtype=np.uint8)
     out[inside] = m.cells[r[inside], c[inside]]

@@ -147,3 +147,13 @@ def test_does_not_step_towards_an_obstacle_within_its_clearance():
     harness = follow(ExplorationMap.from_cells(FRAME, cells), goal_to(3.0), check_distance=0.0, clearance=0.1)
     harness.tick()
     assert harness.read("/robot/command").v == 0.0 and harness.behaviour.safety_stops == 1
+
+
+def test_a_path_with_just_enough_clearance_is_not_blocked():
+    """Through a doorway: obstacle cells 0.26 m either side of the path, the robot's radius 0.25."""
+    m = room()
+    cells = m.cells.copy()
+    rows, cols = FRAME.cell_of(np.array([[1.0, 0.3], [1.0, -0.3]]))
+    cells[rows, cols] = Cell.OBSTACLE  # the jambs: cell centres (1.025, +-0.325) and the path at y 0.025
+    harness = follow(ExplorationMap.from_cells(FRAME, cells), goal_to(3.0))
+    assert harness.tick() == Status.RUNNING and harness.behaviour.replans == 0
