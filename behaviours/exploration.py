@@ -170,6 +170,7 @@ class MapStereo(BearingsBehaviour):
         self.area_over_time: list[list[float]] = []
         self.scans: list[list[float]] = []
         self._scan_bins = 0
+        self._logged = -1  # the integration last logged to rerun
 
     def update(self) -> Status:
         pose = self.get_input("odometry", None)
@@ -249,7 +250,7 @@ class MapStereo(BearingsBehaviour):
     def log_rerun(self, rec: Any) -> None:
         """The explored area, the obstacles and the borders (an image over the odometry frame), the
         points and the interest edges (3-D), every 10th integration."""
-        if self.map is None or len(self.scans) % 10 != 1 or getattr(self, "_logged", -1) == len(self.scans):
+        if self.map is None or len(self.scans) % 10 != 1 or self._logged == len(self.scans):
             return
         self._logged = len(self.scans)
         import rerun as rr
@@ -303,7 +304,7 @@ class SelectGoalPoint(BearingsBehaviour):
                   doc="keep the current goal while its power (frontier: cost) is this close to the best"),
         InputPort("reselect", float, 2.0, unit="s", minimum=0.1, maximum=600.0, literal_only=True,
                   doc="choose again this often while driving"),
-        InputPort("reach", float, 0.45, unit="m", minimum=0.05, maximum=5.0, literal_only=True,
+        InputPort("reach", float, 0.6, unit="m", minimum=0.05, maximum=5.0, literal_only=True,
                   doc="a goal this close is reached"),
         InputPort("min_sightings", int, 2, minimum=1, maximum=1000, literal_only=True,
                   doc="points seen in fewer observations do not attract"),
@@ -336,6 +337,7 @@ class SelectGoalPoint(BearingsBehaviour):
         self.selections = 0
         self.reached = 0
         self.abandoned = 0
+        self._logged: Goal | None = None  # the goal last logged to rerun
 
     def initialise(self) -> None:
         self.goal = None  # choose afresh on every entry
@@ -419,7 +421,7 @@ class SelectGoalPoint(BearingsBehaviour):
     def log_rerun(self, rec: Any) -> None:
         """The goal: its border point, its path and the attracting point."""
         goal = self.goal
-        if goal is None or getattr(self, "_logged", None) is goal:
+        if goal is None or self._logged is goal:
             return
         self._logged = goal
         import rerun as rr

@@ -10,10 +10,9 @@ from py_trees.common import Status
 
 from behaviours.exploration import MapStereo, SelectGoalPoint, drop_jumps, pack_cells, unpack_cells
 from behaviours.testing import BehaviourHarness
-from drivers.interfaces import PanTiltState
 from drivers.sim.simulation import Simulation
 from maps.exploration import Cell, ExplorationMap, GridFrame
-from maps.exploration_goal import Goal, Mode
+from maps.exploration_goal import Mode
 from perception.geometry import Pose2D
 
 MAP, GOAL, POSE = "/map/exploration", "/map/exploration_goal", "/robot/pose"
@@ -209,7 +208,3 @@ def test_waits_for_the_map():
     harness = BehaviourHarness(select(), blackboard={POSE: Pose2D()})
     assert harness.tick() == Status.RUNNING and harness.read(GOAL) is None
 
-
-def test_goal_type_is_the_maps():
-    assert SelectGoalPoint.PORTS[-1].type is Goal
-    assert PanTiltState  # the map node reads the unit's state type

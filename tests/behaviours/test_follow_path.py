@@ -89,7 +89,7 @@ def test_stops_before_unseen_floor_and_says_where_it_is():
         drive(harness)
         harness.clock.advance(0.2)
     x = harness.read("/robot/odometry").x
-    assert 1.0 < x <= 1.525 - 0.25  # the disc never covers an unknown cell (centres from 1.525)
+    assert 1.525 - 0.25 - 0.3 - 0.05 < x <= 1.525 - 0.25 - 0.3 + 0.01  # unseen_margin before the first unknown cell
     assert harness.behaviour.blind_stops > 0
 
 
@@ -139,14 +139,33 @@ def test_a_stall_backs_away_then_gives_up():
     assert harness.behaviour.report_sections()["exploration"]["stalls"] == 3
 
 
-def test_does_not_step_towards_an_obstacle_within_its_clearance():
-    m = room()
-    cells = m.cells.copy()
-    rows, cols = FRAME.cell_of(np.array([[0.3, 0.32]]))
-    cells[rows[0], cols[0]] = Cell.OBSTACLE  # beside the path, 0.32 m off: the path is clear, the step is not
-    harness = follow(ExplorationMap.from_cells(FRAME, cells), goal_to(3.0), check_distance=0.0, clearance=0.1)
+def with_obstacles(*xy: tuple[float, float]) -> ExplorationMap:
+    cells = room().cells.copy()
+    for x, y in xy:
+        rows, cols = FRAME.cell_of(np.array([[x, y]]))
+        cells[rows[0], cols[0]] = Cell.OBSTACLE
+    return ExplorationMap.from_cells(FRAME, cells)
+
+
+def test_slows_to_stop_before_an_obstacle_the_arc_would_touch():
+    # a post 0.32 m beside the path at x = 0.6: the path is clear (radius 0.25), the robot with 0.1 m more is not
+    harness = follow(with_obstacles((0.6, 0.32)), goal_to(3.0), check_distance=0.0, clearance=0.1)
+    post = np.array([0.625, 0.325])  # its cell's centre
+    closest = math.inf
+    for _ in range(60):
+        harness.tick()
+        drive(harness)
+        harness.clock.advance(0.2)
+        pose = harness.read("/robot/odometry")
+        closest = min(closest, float(np.hypot(pose.x - post[0], pose.y - post[1])))
+    assert closest >= 0.35 - 0.01 and harness.behaviour.safety_stops > 0
+
+
+def test_a_wall_alongside_does_not_slow_the_robot():
+    harness = follow(with_obstacles(*[(x, 0.32) for x in np.arange(-0.5, 3.0, 0.05)]), goal_to(3.0),
+                     check_distance=0.0, clearance=0.1)
     harness.tick()
-    assert harness.read("/robot/command").v == 0.0 and harness.behaviour.safety_stops == 1
+    assert harness.read("/robot/command").v == pytest.approx(0.4)
 
 
 def test_a_path_with_just_enough_clearance_is_not_blocked():

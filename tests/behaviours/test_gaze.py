@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.composites import RecoveryNode  # noqa: F401 - the registry's modules import cleanly together
 from behaviours.control import Parallel
 from behaviours.follow_path import FollowPath
 from behaviours.gaze import LookAround, WatchInterestEdges
