@@ -203,7 +203,7 @@ class ExplorationMap:
     edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     interest: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.uint8))
     visited: np.ndarray | None = None
-    sightings: np.ndarray | None = None
+    sightings: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int32))
     cells: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -213,7 +213,7 @@ class ExplorationMap:
             raise ValueError("every edge needs an interest state")
         if self.visited is None:
             object.__setattr__(self, "visited", np.zeros(self.frame.shape, dtype=bool))
-        if self.sightings is None:
+        if len(self.sightings) == 0 and len(self.points):  # points given without counts count once
             object.__setattr__(self, "sightings", np.ones(len(self.points), dtype=np.int32))
         if len(self.sightings) != len(self.points):
             raise ValueError("every point needs a count of sightings")
