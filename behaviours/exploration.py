@@ -270,17 +270,18 @@ class SelectGoalPoint(BearingsBehaviour):
     the closest reachable border point, until one is (``strategy: closest_frontier``: frontier
     mode always, the evaluation's baseline). The goal is chosen again every ``reselect`` seconds
     (the map grows as the robot drives; the current goal is kept while within ``hysteresis`` of the
-    best) and when the robot is within ``reach`` of it (its point is then spent, its border point
-    avoided for good: the unknown beyond it cannot be seen from there). Points seen in fewer than
+    best) and when the robot is within ``reach`` of it (its point is then spent and its border point
+    avoided: the unknown beyond it was not seen from there). Points seen in fewer than
     ``min_sightings`` observations do not attract (stray stereo matches).
 
     RUNNING while there is a goal (written to ``goal``; path following and the gaze read it);
     SUCCESS when no border has been reachable ``patience`` selections in a row (DONE); FAILURE
     when no border is reachable but patience is not used up: look around and tick it again (a
     recovery). A goal abandoned because the branch was halted (path following failed: a path
-    blocked by what the cameras saw on the way) is spent and its border point avoided; but before
-    a selection finds no border, the abandoned border points get a second chance (the map may have
-    changed since: a doorway's stray obstacles cleared); one abandoned again is avoided for good.
+    blocked by what the cameras saw on the way) is spent and its border point avoided too. Before a
+    selection finds no border, the avoided border points get a second chance (the map may have
+    changed since: a doorway's stray obstacles cleared; the cameras looked elsewhere on arrival);
+    one reached or abandoned again is avoided for good.
     The mode, strikes, spent points and avoided targets outlive re-entries.
     """
 
@@ -328,9 +329,9 @@ class SelectGoalPoint(BearingsBehaviour):
         )  # fmt: skip
         self.switch = ModeSwitch()
         self.goal: Goal | None = None
-        self.avoid: list[tuple[float, float]] = []  # abandoned: avoided until a second chance
+        self.avoid: list[tuple[float, float]] = []  # reached or abandoned: avoided until a second chance
         self.forgiven: list[tuple[float, float]] = []  # had their second chance
-        self.given_up: list[tuple[float, float]] = []  # reached (or abandoned twice): avoided for good
+        self.given_up: list[tuple[float, float]] = []  # reached or abandoned twice: avoided for good
         self.selected_at = -math.inf
         self.goals: list[list[Any]] = []
         self.mode_switches: list[list[Any]] = []
@@ -356,7 +357,7 @@ class SelectGoalPoint(BearingsBehaviour):
         if reached and goal is not None:
             self.reached += 1
             self.switch = self.switch.spend(goal.point)
-            self.given_up.append(goal.target)
+            self._avoid(goal.target)
         before = self.switch
         self._select(m, pose, None if reached else goal)
         if self.goal is None and self.avoid:  # a second chance for the abandoned border points
@@ -374,6 +375,11 @@ class SelectGoalPoint(BearingsBehaviour):
         g = self.goal
         self.feedback_message = f"{g.mode.value}: to ({g.target[0]:.2f}, {g.target[1]:.2f}), G {g.cost:.2f} m"
         return Status.RUNNING
+
+    def _avoid(self, target: tuple[float, float]) -> None:
+        """Avoid a border point reached or abandoned: until its second chance, or for good after it."""
+        again = any(math.dist(target, f) <= self.params.avoid_radius for f in self.forgiven)
+        (self.given_up if again else self.avoid).append(target)
 
     def _select(self, m: ExplorationMap, pose: Pose2D, current: Goal | None) -> None:
         before = self.switch.mode
@@ -396,9 +402,7 @@ class SelectGoalPoint(BearingsBehaviour):
         if new_status == Status.INVALID and self.goal is not None:  # halted: the goal could not be followed
             self.abandoned += 1
             self.switch = self.switch.spend(self.goal.point)
-            target = self.goal.target
-            again = any(math.dist(target, f) <= self.params.avoid_radius for f in self.forgiven)
-            (self.given_up if again else self.avoid).append(target)
+            self._avoid(self.goal.target)
             self.goal = None
             self.set_output("goal", None)
 

@@ -18,21 +18,22 @@ disparities) and may be looking sideways:
   (:func:`free_travel`). Pure pursuit cuts corners, and a stop commanded at once still coasts a
   quarter of a metre at 0.4 m/s (0.3 m/s^2): in one simulated run the robot swung round a table's
   corner on a path planned clear of it and touched it while coasting.
-- **Seen floor ahead only**: the robot does not drive *into* floor it has not seen: the forward
-  speed is limited to stop ``unseen_margin`` before the first point of the path ahead where the
-  front of its disc (within ``front`` of the direction of travel) covers an unknown cell (beyond
-  the disc it covers now): far enough for the cameras to still see that floor (their near edge is
-  ~0.36 m from the lens at the lowest tilt), and slow enough that an obstacle found there is not
-  reached while the base decelerates (in one simulated run the robot, at full speed with unseen
-  floor 0.6 m ahead round a table's corner, saw the corner, gave the goal up and touched it while
-  coasting to a stop). Those cells go to ``unseen_ahead`` (None when the next ``guard`` metres are seen), for the
-  gaze to look at, since the cameras may be watching something else
-  (:class:`behaviours.gaze.WatchInterestEdges`). Unknown floor *beside* the path does not hold the
-  robot: within ~0.5 m of the lens the cameras see nothing, so floor beside a path along a border
-  would never become seen from it (tried: the robot stalled at every border it drove along); a
-  tall obstacle there would have been seen ahead, from farther away, by cameras looking where the
-  robot goes. The goal itself is a border point, next to the unknown: the robot stops about a
-  radius before it unless the cameras see beyond it first.
+- **Seen floor ahead only**: the robot does not drive *into* floor it has not seen: it brakes to
+  ``crawl`` ``unseen_margin`` before the first point of the path ahead where the front of its disc
+  (within ``front`` of the direction of travel) covers an unknown cell (beyond the disc it covers
+  now), and stops before its disc covers it. Those cells go to ``unseen_ahead`` (None when the
+  next ``guard`` metres are seen), for the gaze to look at, since the cameras may be watching
+  something else (:class:`behaviours.gaze.WatchInterestEdges`). The margin is where the cameras can
+  still see that floor (their near edge is ~0.36 m from the lens at the lowest tilt), and the
+  crawl stops within 2 cm when they find an obstacle there (in one simulated run the robot, at
+  full speed with unseen floor 0.6 m ahead round a table's corner, saw the corner, gave the goal
+  up and touched it while coasting). Stopping at the margin instead deadlocks at corners: the
+  floor round a corner is seen only by moving along the path. Unknown floor *beside* the path does
+  not hold the robot: within ~0.5 m of the lens the cameras see nothing, so floor beside a path
+  along a border would never become seen from it (tried: the robot stalled at every border it
+  drove along); a tall obstacle there would have been seen ahead, from farther away, by cameras
+  looking where the robot goes. The goal itself is a border point, next to the unknown: the robot
+  stops about a radius before it unless the cameras see beyond it first.
 - **Progress**: no metre of path gained for ``stuck_time`` seconds (a stop before unseen floor the
   cameras cannot see from here: nearer than their ~0.5 m blind zone): FAILURE, so that a recovery
   looks around and the goal is chosen again.
@@ -154,7 +155,9 @@ class FollowPath(BearingsBehaviour):
         InputPort("stuck_time", float, 8.0, unit="s", minimum=0.5, maximum=600.0, literal_only=True,
                   doc="give the goal up after this long without progress"),
         InputPort("unseen_margin", float, 0.3, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
-                  doc="stop this far before unseen floor ahead: far enough for the cameras to see it"),
+                  doc="brake to a crawl this far before unseen floor ahead (the cameras can still see it)"),
+        InputPort("crawl", float, 0.1, unit="m/s", minimum=0.0, maximum=1.0, literal_only=True,
+                  doc="the speed from there on, until the disc would touch it"),
         InputPort("front", float, 60.0, unit="deg", minimum=0.0, maximum=180.0, literal_only=True,
                   doc="unseen floor within this of the direction of travel holds the robot (180: the whole disc)"),
         GOAL,
@@ -251,8 +254,9 @@ class FollowPath(BearingsBehaviour):
             self.command(0.0, w)
             self.feedback_message = f"turning towards the path ({math.degrees(error):+.0f} deg)"
             return Status.RUNNING
-        see = float(self.get_input("unseen_margin"))  # stop where the cameras can still see it
-        blind = math.sqrt(2.0 * LINEAR_DECEL * max(seen - see, 0.0))
+        see = float(self.get_input("unseen_margin"))  # brake to a crawl where the cameras can still see it
+        crawl = float(self.get_input("crawl")) if seen > m.frame.resolution else 0.0
+        blind = max(math.sqrt(2.0 * LINEAR_DECEL * max(seen - see, 0.0)), crawl)
         v = min(ramp(remaining, float(self.get_input("speed")), LINEAR_DECEL, 0.02),
                 float(self.get_input("speed_limit", math.inf)), blind)
         v = max(0.0, v * math.cos(error))

@@ -161,13 +161,15 @@ def test_reaching_the_goal_spends_its_point_and_chooses_again():
     harness = BehaviourHarness(select(), blackboard={MAP: explored_room([FAR_EAST]), POSE: Pose2D(0.5, 1.0)})
     harness.tick()
     target = harness.read(GOAL).target
-    harness.write(POSE, Pose2D(target[0] - 0.3, target[1]))  # within reach (0.45 m)
-    harness.tick()
-    goal = harness.read(GOAL)
+    harness.write(POSE, Pose2D(target[0] - 0.3, target[1]))  # within reach (0.6 m)
+    assert harness.tick() == Status.RUNNING
     assert 0 in harness.behaviour.switch.spent and harness.behaviour.reached == 1
-    # the point is spent and the gap's border near the reached target avoided: nothing else is left
-    assert goal is None and harness.behaviour.status == Status.FAILURE
-    assert harness.behaviour.given_up == [target]
+    # the point is spent, the gap's border avoided; nothing else is left: the gap's second chance
+    goal = harness.read(GOAL)
+    assert goal.mode is Mode.FRONTIER and harness.behaviour.forgiven == [target]
+    harness.clock.advance(0.1)
+    assert harness.tick() == Status.FAILURE  # reached again: avoided for good, no border left: look around
+    assert harness.read(GOAL) is None and harness.behaviour.reached == 2 and len(harness.behaviour.given_up) == 1
 
 
 def test_no_reachable_border_fails_until_patience_then_succeeds():

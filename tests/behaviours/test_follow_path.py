@@ -89,8 +89,14 @@ def test_stops_before_unseen_floor_and_says_where_it_is():
         drive(harness)
         harness.clock.advance(0.2)
     x = harness.read("/robot/odometry").x
-    assert 0.9 < x <= 1.525 - 0.25 + 0.05 - 0.3  # unseen_margin before the path point whose disc reaches it
+    assert 1.2 < x <= 1.525 - 0.25  # it crawls on from unseen_margin before, and the disc never covers it
     assert harness.behaviour.blind_stops > 0
+
+
+def test_crawls_within_the_margin_of_unseen_floor():
+    harness = follow(room(unknown_from=1.5), goal_to(3.0), pose=Pose2D(1.1, 0.0, 0.0), crawl=0.1, unseen_margin=0.3)
+    harness.tick()
+    assert harness.read("/robot/command").v == pytest.approx(0.1)
 
 
 def test_unseen_floor_beside_the_path_does_not_hold_the_robot():
