@@ -37,19 +37,17 @@ class NotSetUp(RuntimeError):
     """A behaviour ticked before ``setup(clock=...)``: the tree was not set up by a runner."""
 
 
-class BearingsBehaviour(Declared, py_trees.behaviour.Behaviour):
-    """A leaf behaviour with typed ports; subclasses implement ``initialise``/``update``.
+class PortedNode(Declared):
+    """Declared ports, blackboard access and the clock, for any kind of node (mixed in first).
 
-    Construct with the node's name and its ports as keyword arguments, exactly as a mission
-    writes them: literals, ``"{/ns/key}"`` references for inputs, keys for outputs::
-
-        Perceive(name="front eyes", camera="front", observation="{/perception/front}")
+    :class:`BearingsBehaviour` (leaves) and :class:`BearingsDecorator` (decorators that also read
+    and write the blackboard, like ``LearnRoute``) are this plus a py_trees base class; a
+    subclass calls :meth:`_bind` with its ports after the py_trees constructor.
     """
 
-    KIND: ClassVar[Kind] = "action"
-
-    def __init__(self, name: str | None = None, **ports: Any) -> None:
-        super().__init__(name=name or type(self).__name__)
+    def _bind(self, ports: dict[str, Any]) -> None:
+        """Check ``ports`` against the declaration and grant the blackboard access they need."""
+        assert isinstance(self, py_trees.behaviour.Behaviour)
         self.inputs, self.outputs = bind_ports(type(self).__name__, self.PORTS, ports)
         self.bb = self.attach_blackboard_client(name=self.name)
         for key in read_keys(self.PORTS, self.inputs):
@@ -68,7 +66,8 @@ class BearingsBehaviour(Declared, py_trees.behaviour.Behaviour):
     @property
     def clock(self) -> Clock:
         if self._clock is None:
-            raise NotSetUp(f"{self.name}: no clock; set the tree up with setup(clock=...)")
+            raise NotSetUp(f"{getattr(self, 'name', type(self).__name__)}: no clock; set the tree up with "
+                           "setup(clock=...)")
         return self._clock
 
     def now(self) -> float:
@@ -87,20 +86,50 @@ class BearingsBehaviour(Declared, py_trees.behaviour.Behaviour):
             return self.bb.get(value.key)
         except KeyError:
             if default is _UNSET:
-                raise KeyError(f"{self.name}: input {port!r} reads {value}, which is not set yet") from None
+                raise KeyError(f"{self.bb.name}: input {port!r} reads {value}, which is not set yet") from None
             return default
 
     def set_output(self, port: str, value: Any) -> None:
         """Write an output port's key; a value of the wrong type is a bug in the behaviour."""
         expected = self._output_types[port]
         if not matches_type(value, expected):
-            raise TypeError(f"{self.name}: output {port!r} is declared {type_name(expected)}, "
+            raise TypeError(f"{self.bb.name}: output {port!r} is declared {type_name(expected)}, "
                             f"got {type(value).__name__}")
         self.bb.set(self.outputs[port], value, overwrite=True)
 
     def output_key(self, port: str) -> str:
         """The blackboard key an output port writes (after remapping)."""
         return self.outputs[port]
+
+
+class BearingsBehaviour(PortedNode, py_trees.behaviour.Behaviour):
+    """A leaf behaviour with typed ports; subclasses implement ``initialise``/``update``.
+
+    Construct with the node's name and its ports as keyword arguments, exactly as a mission
+    writes them: literals, ``"{/ns/key}"`` references for inputs, keys for outputs::
+
+        Perceive(name="front eyes", camera="front", observation="{/perception/front}")
+    """
+
+    KIND: ClassVar[Kind] = "action"
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
+        super().__init__(name=name or type(self).__name__)
+        self._bind(ports)
+
+
+class BearingsDecorator(PortedNode, py_trees.decorators.Decorator):
+    """A decorator with typed ports: around one child, it reads and writes the blackboard like a leaf.
+
+    Built as the loader builds decorators: ``cls(name=..., child=..., **ports)``.
+    """
+
+    KIND: ClassVar[Kind] = "decorator"
+    CHILDREN: ClassVar[tuple[int, int | None]] = (1, 1)
+
+    def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
+        super().__init__(name=name, child=child)
+        self._bind(ports)
 
 
 def read_keys(declared: tuple[Port, ...], inputs: dict[str, Any]) -> list[str]:

@@ -40,7 +40,10 @@ COMMAND = OutputPort("command", VelocityCommand, "/robot/command", unit="m/s, ra
 MOTION_PORTS: tuple[Port, ...] = (ODOMETRY, STALLED, COMMAND)
 
 
-class _OdometryMotion(BearingsBehaviour):
+class OdometryMotion(BearingsBehaviour):
+    """The base of motion on odometry: waits for odometry, fails (stopped) when stalled, stops when
+    it ends or is halted; subclasses implement :meth:`step` (plugins may subclass it too)."""
+
     PORTS: ClassVar[tuple[Port, ...]] = MOTION_PORTS
 
     def odometry(self) -> Pose2D | None:
@@ -75,7 +78,7 @@ class _OdometryMotion(BearingsBehaviour):
 
 
 @register
-class Drive(_OdometryMotion):
+class Drive(OdometryMotion):
     """Drive straight ``distance`` metres (negative: backwards), holding the starting heading."""
 
     PORTS = (
@@ -105,7 +108,7 @@ class Drive(_OdometryMotion):
 
 
 @register
-class Rotate(_OdometryMotion):
+class Rotate(OdometryMotion):
     """Turn on the spot by ``angle`` degrees (positive: counter-clockwise)."""
 
     PORTS = (
@@ -134,7 +137,7 @@ class Rotate(_OdometryMotion):
 
 
 @register
-class DriveTo(_OdometryMotion):
+class DriveTo(OdometryMotion):
     """Drive to the point (x, y) of the odometry frame: turn towards it, then drive while steering."""
 
     PORTS = (
@@ -162,7 +165,7 @@ class DriveTo(_OdometryMotion):
 
 
 @register
-class Stop(_OdometryMotion):
+class Stop(OdometryMotion):
     """Command the base to rest; SUCCESS at once (with or without odometry, stalled or not)."""
 
     PORTS = (COMMAND,)

@@ -36,9 +36,16 @@ from behaviours.ports import InputPort, OutputPort, Port
 Kind = Literal["action", "condition", "decorator", "composite"]
 KINDS: tuple[Kind, ...] = ("action", "condition", "decorator", "composite")
 ENTRY_POINT_GROUP = "bearings.behaviours"
-BUILTIN_MODULES = ("behaviours.control", "behaviours.composites", "behaviours.decorators", "behaviours.motion",
-                   "behaviours.wait", "behaviours.conditions", "behaviours.perceive", "behaviours.localise",
-                   "behaviours.exploration", "behaviours.follow_path", "behaviours.gaze")
+BUILTIN_MODULES = (
+    "behaviours.control", "behaviours.composites", "behaviours.decorators", "behaviours.motion", "behaviours.wait",
+    "behaviours.conditions", "behaviours.perceive",
+    # teach and repeat (the LT-map)
+    "behaviours.landmark_tree", "behaviours.teach", "behaviours.route", "behaviours.search", "behaviours.teleop",
+    "behaviours.waypoints", "behaviours.choice",
+    # the roadmap between target images
+    *(f"behaviours.roadmap.{m}" for m in ("targets", "calibration", "room", "coverage", "travel", "scan", "homing",
+                                          "graph", "navigate")),
+)  # fmt: skip
 _MARK = "__bearings_node_type__"
 
 

@@ -83,3 +83,17 @@ def fake_robot(*, ptu: bool = False, cameras: tuple[str, ...] = ()) -> Robot:
         cameras={name: FakeCamera(name=name) for name in cameras},
         name="fake",
     )
+
+
+@dataclass
+class FakeKeys:
+    """A keyboard for tests: each ``read()`` returns the next batch the test queued (then none)."""
+
+    batches: list[list[str]] = field(default_factory=list)
+    closed: bool = False
+
+    def read(self) -> list[str]:
+        return self.batches.pop(0) if self.batches else []
+
+    def close(self) -> None:
+        self.closed = True

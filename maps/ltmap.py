@@ -188,7 +188,8 @@ class MapSummary:
 @dataclass(frozen=True, slots=True, eq=False)
 class PruneStep:
     """One level cut by :meth:`LandmarkTree.prune_level`; ``landmark_index[i]`` is the new index of
-    old landmark ``i`` (-1: deleted)."""
+    old landmark ``i`` (-1: deleted), ``viewframe_index[v]`` the new index of old viewframe ``v``
+    (merged ones: the viewframe they merged into; -1: deleted)."""
 
     height_before: int
     height_after: int
@@ -198,6 +199,7 @@ class PruneStep:
     viewframes_merged: int
     viewframes_deleted: int
     landmark_index: np.ndarray
+    viewframe_index: np.ndarray
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -212,6 +214,7 @@ class PruneReport:
     smallest_bytes: int
     steps: tuple[PruneStep, ...]
     landmark_index: np.ndarray
+    viewframe_index: np.ndarray
 
     @property
     def levels_cut(self) -> int:
@@ -519,15 +522,18 @@ class LandmarkTree:
         for terminal in {self._leaves[0], self._leaves[-1]}:  # start and goal keep their landmarks
             node[node == terminal] = parent[terminal]
         keep = ~np.isin(node, self._leaves)
-        ends = list(dict.fromkeys(int(parent[leaf]) for leaf in self._leaves))  # same end: one viewframe
+        old_ends = [int(parent[leaf]) for leaf in self._leaves]
+        ends = list(dict.fromkeys(old_ends))  # same end: one viewframe
         merged = len(self._leaves) - len(ends)
         counts = np.bincount(node[keep], minlength=len(parent))
         sizes = _branch_sizes(parent, counts, ends)
         weak = {k for k in range(1, len(ends) - 1) if sizes[k] < min_landmarks}
-        ends, identical = _merge_identical(parent, counts, [e for k, e in enumerate(ends) if k not in weak])
+        candidates = [e for k, e in enumerate(ends) if k not in weak]
+        ends, identical = _merge_identical(parent, counts, candidates)
+        viewframes = _viewframe_index(parent, counts, old_ends, candidates, ends)
         index = self._restructure(parent, node, keep, ends)
         return PruneStep(before[0], self.height, before[1], self.memory_bytes(), before[2] - self.landmark_count,
-                         merged + identical, len(weak), index)
+                         merged + identical, len(weak), index, viewframes)
 
     def prune_to(self, budget_bytes: int, min_landmarks: int = DEFAULT_MIN_LANDMARKS) -> PruneReport:
         """Cut levels until :meth:`memory_bytes` <= ``budget_bytes``; the map is unchanged when it cannot."""
@@ -535,19 +541,20 @@ class LandmarkTree:
             raise ValueError(f"budget must be >= 0 bytes, got {budget_bytes}")
         before = self.memory_bytes()
         work, steps = self.copy(), list[PruneStep]()
-        index = np.arange(self.landmark_count)
+        index, viewframes = np.arange(self.landmark_count), np.arange(self.viewframe_count)
         while work.memory_bytes() > budget_bytes:
             step = work.prune_level(min_landmarks)
             if step is None:
                 return PruneReport(budget_bytes, False, before, before, work.memory_bytes(), tuple(steps),
-                                   np.arange(self.landmark_count))
+                                   np.arange(self.landmark_count), np.arange(self.viewframe_count))
             steps.append(step)
             index = np.where(index >= 0, step.landmark_index[np.maximum(index, 0)], -1)
+            viewframes = np.where(viewframes >= 0, step.viewframe_index[np.maximum(viewframes, 0)], -1)
         if steps:
             self._parent, self._leaves, self._rows = work._parent, work._leaves, work._rows
             self._cache.clear()
         after = self.memory_bytes()
-        return PruneReport(budget_bytes, True, before, after, after, tuple(steps), index)
+        return PruneReport(budget_bytes, True, before, after, after, tuple(steps), index, viewframes)
 
     def _restructure(self, parent: np.ndarray, node: np.ndarray, keep: np.ndarray, ends: list[int]) -> np.ndarray:
         """Keep the nodes some viewframe passes through, merge a single-child root, renumber the
@@ -653,13 +660,29 @@ def _merge_identical(parent: np.ndarray, counts: np.ndarray, ends: Sequence[int]
     """Keep the first of viewframes whose non-empty nodes are the same (their landmark sets are equal)."""
     kept: dict[tuple[int, ...], int] = {}
     for end in ends:
-        signature, n = [], end
-        while n >= 0:
-            if counts[n]:
-                signature.append(int(n))
-            n = parent[n]
-        kept.setdefault(tuple(signature), end)
+        kept.setdefault(_signature(parent, counts, end), end)
     return list(kept.values()), len(ends) - len(kept)
+
+
+def _signature(parent: np.ndarray, counts: np.ndarray, end: int) -> tuple[int, ...]:
+    """The non-empty nodes of the branch ending in ``end`` (equal signatures: equal landmark sets)."""
+    signature, n = [], end
+    while n >= 0:
+        if counts[n]:
+            signature.append(int(n))
+        n = parent[n]
+    return tuple(signature)
+
+
+def _viewframe_index(parent: np.ndarray, counts: np.ndarray, old_ends: Sequence[int], candidates: Sequence[int],
+                     ends: Sequence[int]) -> np.ndarray:
+    """Per old viewframe (its branch now ending in ``old_ends[v]``), the index among the kept ``ends``
+    of the viewframe it became (the one with its landmark set), or -1 when it was deleted (its end
+    is not among the ``candidates`` that survived the landmark minimum)."""
+    kept = {_signature(parent, counts, end): k for k, end in enumerate(ends)}
+    survivors = set(candidates)
+    return np.array([kept[_signature(parent, counts, end)] if end in survivors else -1 for end in old_ends],
+                    dtype=np.int64).reshape(-1)
 
 
 def _preorder(parent: np.ndarray, alive: np.ndarray, ends: Sequence[int]) -> list[int]:

@@ -92,11 +92,18 @@ class _SafeLoader(_BASE_LOADER):
     floats: ``1e-3`` and ``1.0e9`` are numbers, not text."""
 
 
-_SafeLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
-    list("-+0123456789"),
-)
+YAML12_FLOAT = re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$")
+"""Numbers YAML 1.2 reads as floats and PyYAML's YAML 1.1 as text (``1e-3``, ``1.0e9``)."""
+
+_SafeLoader.add_implicit_resolver("tag:yaml.org,2002:float", YAML12_FLOAT, list("-+0123456789"))
+
+
+class _Dumper(yaml.SafeDumper):
+    """PyYAML's safe dumper, quoting text that YAML 1.2 reads as a number, so that what is written
+    reads back (with :func:`parse_yaml`) as the same values."""
+
+
+_Dumper.add_implicit_resolver("tag:yaml.org,2002:float", YAML12_FLOAT, list("-+0123456789"))
 
 
 def _mark(node: yaml.Node) -> Mark:
@@ -294,9 +301,15 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
     write_bytes_atomic(path, text.encode("utf-8"))
 
 
+def dump_yaml(data: Any, *, width: int = 110) -> str:
+    """Plain data as block-style YAML text that :func:`parse_yaml` reads back to the same values."""
+    return yaml.dump(_plain(data), Dumper=_Dumper, sort_keys=False, default_flow_style=None, allow_unicode=True,
+                     width=width)
+
+
 def write_yaml(path: str | os.PathLike, data: Any, *, header: str = "") -> None:
     """Atomically write plain data as block-style YAML, with an optional ``# header`` comment."""
-    body = yaml.safe_dump(_plain(data), sort_keys=False, default_flow_style=None, allow_unicode=True)
+    body = dump_yaml(data)
     comment = "".join(f"# {line}\n" for line in header.splitlines())
     write_text_atomic(path, comment + body)
 

@@ -8,7 +8,8 @@ import sys
 
 from missions.commands import COMMANDS
 
-EPILOG = """exit codes: 0 mission SUCCESS / command done, 1 mission FAILURE, 2 invalid input.
+EPILOG = """exit codes: 0 mission SUCCESS / command done, 1 mission FAILURE, 2 invalid input,
+130/143 interrupted by SIGINT/SIGTERM.
 Run 'bearings COMMAND --help' for the options of one command."""
 
 

@@ -1,26 +1,41 @@
 """Views of a mission tree: a unicode outline, Graphviz dot, and BehaviorTree.CPP v4 XML.
 
-The XML (``<root BTCPP_format="4">``) carries a ``TreeNodesModel`` with every bearings node
-type's typed ``input_port`` and ``output_port`` declarations, so Groot2 can open and display the
-tree; every node writes all its ports, outputs as the ``{/ns/key}`` they write. Composites map
-onto their BT.CPP counterparts (``Sequence``/``ReactiveSequence``, ``Fallback``/
-``ReactiveFallback``, ...).
+The XML (``<root BTCPP_format="4">``) loads in BehaviorTree.CPP and opens in Groot2. Control
+nodes become their BT.CPP counterparts (``Sequence``/``ReactiveSequence``, ``Fallback``/
+``ReactiveFallback``, ``Precondition``, ``RunOnce``, ...) with BT.CPP's own ports; every other node
+type (leaves, Nav2's ``RecoveryNode`` and ``RateController``, what BT.CPP lacks) is declared in
+the ``TreeNodesModel`` with its typed ``input_port``/``output_port``s, and every node writes all
+its ports. Blackboard keys are written with the one reversible mapping of :mod:`missions.btcpp`
+(``{@robot__odometry}``, scripts ``@perception__observation___count >= 50``). ``bearings import``
+(:mod:`missions.importer`) reads the same XML back into the same tree.
 """
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
-from typing import Any
+from collections.abc import Callable
 
-from behaviours.ports import REQUIRED, InputPort, OutputPort, Ref, format_literal, type_name
+from behaviours.ports import REQUIRED, InputPort, OutputPort, Ref, format_literal, parse_ref
 from behaviours.registry import NodeType, Registry
+from maps.store import Diagnostic, InputError
+from missions.btcpp import (
+    BUILTIN_NAMES,
+    SENSE_NAME,
+    SENSE_SUFFIX,
+    UINT32,
+    blackboard_pointer,
+    comparison_script,
+    format_value,
+    is_port_name,
+    literal_problem,
+    model_type,
+    remap,
+)
 from missions.language import MissionSpec, NodeSpec
 
 KIND_GLYPH = {"composite": "", "decorator": "", "action": "--> ", "condition": "--? "}
 BTCPP_MODEL_TAG = {"action": "Action", "condition": "Condition", "decorator": "Decorator", "composite": "Control"}
-
-
-BTCPP_TYPE = {"float": "double", "int": "int", "bool": "bool", "str": "std::string", "key": "std::string"}
 
 
 def _label(node: NodeSpec, registry: Registry) -> str:
@@ -80,15 +95,28 @@ def dot_tree(mission: MissionSpec) -> str:
 
 
 def btcpp_xml(mission: MissionSpec) -> str:
-    """BehaviorTree.CPP v4 XML with a TreeNodesModel, for Groot2."""
-    root = ET.Element("root", {"BTCPP_format": "4", "main_tree_to_execute": _ident(mission.name)})
-    tree = ET.SubElement(root, "BehaviorTree", {"ID": _ident(mission.name)})
-    used: dict[str, NodeType] = {}
-    tree.append(_xml_node(mission.tree, used, mission.registry))
+    """BehaviorTree.CPP v4 XML with a TreeNodesModel, for BT.CPP and Groot2.
+
+    The task tree is the main tree; the ``sense:`` nodes, if any, are a second tree
+    (:data:`~missions.btcpp.SENSE_SUFFIX`). Every attribute written is a declared port: BT.CPP's
+    own for its built-in nodes, the TreeNodesModel's for the others. A construct BT.CPP cannot
+    express raises :class:`~maps.store.InputError` located at the node.
+    """
+    exporter = _BtcppExporter(mission.registry)
+    task = exporter.element(mission.tree)
+    sense = [exporter.element(node) for node in mission.sense]
+    if exporter.problems:
+        raise InputError(exporter.problems)
+    main_id = _ident(mission.name)
+    if main_id in BUILTIN_NAMES or main_id in exporter.models:  # BT.CPP: a tree ID is no node type's name
+        main_id += "Tree"
+    root = ET.Element("root", {"BTCPP_format": "4", "main_tree_to_execute": main_id})
+    ET.SubElement(root, "BehaviorTree", {"ID": main_id}).append(task)
+    if sense:
+        tree = ET.SubElement(root, "BehaviorTree", {"ID": main_id + SENSE_SUFFIX})
+        ET.SubElement(tree, "Sequence", {"name": SENSE_NAME}).extend(sense)
     model = ET.SubElement(root, "TreeNodesModel")
-    for tag, node_type in sorted(used.items()):
-        if tag in BTCPP_BUILTIN:
-            continue
+    for tag, node_type in sorted(exporter.models.items()):
         element = ET.SubElement(model, BTCPP_MODEL_TAG[node_type.kind], {"ID": tag})
         ports: list[InputPort | OutputPort] = [*node_type.inputs, *node_type.outputs]
         for port in ports:
@@ -97,71 +125,137 @@ def btcpp_xml(mission: MissionSpec) -> str:
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-BTCPP_BUILTIN = {"Sequence", "ReactiveSequence", "Fallback", "ReactiveFallback", "Parallel", "Inverter",
-                 "ForceSuccess", "ForceFailure", "RetryUntilSuccessful", "Repeat", "Timeout", "RunOnce",
-                 "AlwaysSuccess", "AlwaysFailure", "Precondition"}
-
-
 def _model_port(element: ET.Element, port: InputPort | OutputPort) -> None:
     """One ``input_port``/``output_port`` of a node type in the TreeNodesModel."""
-    name = type_name(port.type)
-    attrs = {"name": port.name, "type": BTCPP_TYPE.get(name, name)}
+    attrs = {"name": port.name, "type": model_type(port.type)}
     if isinstance(port, OutputPort):
-        attrs["default"] = "{" + port.key + "}"
+        attrs["default"] = remap(port.key)
     elif port.default is not REQUIRED and port.default is not None:
-        attrs["default"] = format_literal(port.default)
+        default = parse_ref(port.default) or port.default
+        attrs["default"] = format_value(default)
     tag = "output_port" if isinstance(port, OutputPort) else "input_port"
     ET.SubElement(element, tag, attrs).text = port.doc + (f" [{port.unit}]" if port.unit else "")
 
 
-def _reactive(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
-    return (tag if params.pop("memory", True) else "Reactive" + tag), {}
+Attributes = dict[str, str]
+Translation = tuple[str, Attributes] | str  # (BT.CPP tag, its attributes), or why there is none
 
 
-def _timeout(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
-    return tag, {"msec": str(round(params.pop("duration") * 1000))}
+def _memory(tag: str) -> Callable[[NodeSpec], Translation]:
+    def translate(node: NodeSpec) -> Translation:
+        return (tag if node.inputs["memory"] else "Reactive" + tag), {}
+    return translate
 
 
-def _parallel(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
-    policy, _ = params.pop("policy"), params.pop("synchronise")
-    count = len(node.children) if policy == "all" else 1
-    return tag, {"success_count": str(count), "failure_count": "1"}
+def _parallel(node: NodeSpec) -> Translation:
+    if not node.inputs["synchronise"]:
+        return ("Parallel with synchronise: false has no BehaviorTree.CPP equivalent (BT.CPP's Parallel never "
+                "ticks a child again once it succeeded)")
+    success = -1 if node.inputs["policy"] == "all" else 1
+    return "Parallel", {"success_count": str(success), "failure_count": "1"}
 
 
-def _run_once(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
-    params.pop("policy")
-    return tag, {"then_skip": "true"}
+def _timeout(node: NodeSpec) -> Translation:
+    duration = node.inputs["duration"]
+    msec = round(duration * 1000) if math.isfinite(duration) else -1
+    if msec / 1000 != duration:
+        return f"Timeout.duration {duration!r} s is not a whole number of milliseconds (BT.CPP's Timeout takes msec)"
+    problem = literal_problem(msec, UINT32)
+    return f"Timeout.duration: {problem}" if problem else ("Timeout", {"msec": str(msec)})
 
 
-def _precondition(node: NodeSpec, params: dict[str, Any], tag: str) -> tuple[str, dict[str, str]]:
-    key, op, value = params.pop("key"), params.pop("op"), params.pop("value")
-    return tag, {"if": f"{{{key}}} {op} {format_literal(value)}", "else": "FAILURE"}
+def _one_shot(node: NodeSpec) -> Translation:
+    if node.inputs["policy"] == "on_completion":
+        return "RunOnce", {"then_skip": "false"}
+    return "OneShot", {"policy": "on_success"}  # BT.CPP lacks it: declared in the TreeNodesModel
 
 
-# Where a bearings control node's ports differ from its BT.CPP counterpart's attributes.
-_TRANSLATE = {"Sequence": _reactive, "Selector": _reactive, "Timeout": _timeout, "Parallel": _parallel,
-              "OneShot": _run_once, "Guard": _precondition}
+def _script(node: NodeSpec) -> str | None:
+    return comparison_script(node.inputs["key"], node.inputs["op"], node.inputs["value"])
 
 
-def _xml_node(node: NodeSpec, used: dict[str, NodeType], registry: Registry) -> ET.Element:
-    node_type = registry.lookup(node.type)
-    if node_type is None:
-        raise ValueError(f"unknown node type {node.type!r}")
-    params: dict[str, Any] = dict(node.inputs)
-    translate = _TRANSLATE.get(node.type)
-    tag, attrs = translate(node, params, node_type.btcpp) if translate else (node_type.btcpp, {})
-    for key, value in params.items():
-        if value is not None:
-            attrs[key] = format_literal(value)
-    for key, target in node.outputs.items():
-        attrs[key] = "{" + target + "}"
-    if node.name != node.type:
-        attrs = {"name": node.name, **attrs}
-    used[tag] = node_type
-    element = ET.Element(tag, attrs)
-    for child in node.children:
-        element.append(_xml_node(child, used, registry))
-    return element
+def _guard(node: NodeSpec) -> Translation:
+    script = _script(node)
+    if script is None:
+        return f"Guard.value {node.inputs['value']!r} cannot be written in a BehaviorTree.CPP script"
+    return "Precondition", {"if": script, "else": "FAILURE"}
+
+
+def _check(node: NodeSpec) -> Translation:
+    script = _script(node)
+    if script is None:
+        return f"CheckBlackboard.value {node.inputs['value']!r} cannot be written in a BehaviorTree.CPP script"
+    return "ScriptCondition", {"code": script}
+
+
+TRANSLATIONS: dict[str, Callable[[NodeSpec], Translation]] = {
+    "Sequence": _memory("Sequence"), "Selector": _memory("Fallback"), "Parallel": _parallel, "Timeout": _timeout,
+    "OneShot": _one_shot, "Guard": _guard, "CheckBlackboard": _check,
+}  # fmt: skip
+"""bearings' control nodes whose ports differ from their BT.CPP counterpart's."""
+
+SAME_PORTS = frozenset({"Retry", "Repeat", "Inverter", "ForceSuccess", "ForceFailure", "Success", "Failure"})
+"""bearings' node types that are a BT.CPP built-in with the same ports, under their ``BTCPP`` name."""
+
+
+class _BtcppExporter:
+    """Turns NodeSpecs into BT.CPP elements, collecting the node types the TreeNodesModel declares."""
+
+    def __init__(self, registry: Registry) -> None:
+        self.registry = registry
+        self.models: dict[str, NodeType] = {}
+        self.problems: list[Diagnostic] = []
+
+    def problem(self, node: NodeSpec, message: str) -> None:
+        where = node.location
+        self.problems.append(Diagnostic(where.file, where.line, where.col, message))
+
+    def element(self, node: NodeSpec) -> ET.Element:
+        node_type = self.registry.lookup(node.type)
+        if node_type is None:
+            raise ValueError(f"unknown node type {node.type!r}")
+        tag, attrs = self._translate(node, node_type)
+        if node.name != node.type:
+            attrs = {"name": node.name, **attrs}
+        element = ET.Element(tag, attrs)
+        element.extend(self.element(child) for child in node.children)
+        return element
+
+    def _translate(self, node: NodeSpec, node_type: NodeType) -> tuple[str, Attributes]:
+        translate = TRANSLATIONS.get(node.type)
+        translated = translate(node) if translate else (node_type.btcpp, self._ports(node, node_type))
+        if isinstance(translated, str):
+            self.problem(node, translated)
+            return node_type.btcpp, {}
+        tag, attrs = translated
+        if tag in BUILTIN_NAMES:
+            if translate is None and node.type not in SAME_PORTS:
+                self.problem(node, f"{node.type} is exported as <{tag}>, the name of a BehaviorTree.CPP built-in "
+                             "node: give it another BTCPP name")
+        else:
+            self.models[tag] = node_type
+        return tag, attrs
+
+    def _ports(self, node: NodeSpec, node_type: NodeType) -> Attributes:
+        """Every port of a node as BT.CPP reads it (inputs as literals or ``{@key}``, outputs as ``{@key}``)."""
+        attrs: Attributes = {}
+        for name, value in node.inputs.items():
+            if value is None:
+                continue
+            text = format_value(value)
+            problem = None if isinstance(value, Ref) else literal_problem(value)
+            if problem:
+                self.problem(node, f"{node.type}.{name}: {problem}")
+            elif not isinstance(value, Ref) and blackboard_pointer(text) is not None:
+                self.problem(node, f"{node.type}.{name}: the text {text!r} would be a blackboard reference in "
+                             "BehaviorTree.CPP")
+            attrs[name] = text
+        attrs.update({name: remap(key) for name, key in node.outputs.items()})
+        for name in attrs:
+            if not is_port_name(name):
+                self.problem(node, f"{node.type}.{name}: BehaviorTree.CPP takes only port names that start with a "
+                             "letter")
+        return attrs
 
 
 def _ident(text: str) -> str:

@@ -248,6 +248,7 @@ def load_mission(
     sense = _sense(loader, doc, scope)
     tree = loader.reader.node(doc.data["tree"], doc.data.value_mark_of("tree"), scope, 0)
     evaluation = _evaluation(loader, doc, scope)
+    cameras = _cameras(loader, doc, scope)
     if loader.diagnostics or tree is None:
         raise InputError(loader.diagnostics)
     header = doc.header
@@ -256,7 +257,7 @@ def load_mission(
         inputs=declared, values=values, sense=sense, plugins=tuple(loader.plugins), rate_hz=header.rate,
         max_time_s=header.max_time, overrun_s=header.overrun, evaluation=evaluation,
         files=tuple(dict.fromkeys(loader.files)),
-        cameras=tuple(header.cameras) if header.cameras is not None else None, registry=loader.registry,
+        cameras=cameras, registry=loader.registry,
     )  # fmt: skip
     problems = check_dataflow(mission)
     if problems:
@@ -278,6 +279,21 @@ def _sense(loader: _Loader, doc: _Document, scope: Scope) -> tuple[NodeSpec, ...
         return ()  # absent, or already reported by the top-level check
     nodes = [loader.reader.node(item, raw.mark_of(i), scope, 1) for i, item in enumerate(raw)]
     return tuple(n for n in nodes if n is not None)
+
+
+def _cameras(loader: _Loader, doc: _Document, scope: Scope) -> tuple[str, ...] | None:
+    """The cameras the mission grabs, inputs substituted (``cameras: ["${camera}"]``)."""
+    raw = doc.data.get("cameras")
+    if doc.header.cameras is None or not isinstance(raw, YamlList):
+        return None
+    names = []
+    for index, entry in enumerate(doc.header.cameras):
+        name, problem = substitute(entry, scope.values)
+        if problem or not isinstance(name, str) or not name:
+            loader.error(scope.file, raw.mark_of(index), f"cameras[{index}]: {problem or 'a camera name is text'}")
+            continue
+        names.append(name)
+    return tuple(dict.fromkeys(names))
 
 
 def _evaluation(loader: _Loader, doc: _Document, scope: Scope) -> dict[str, Any]:

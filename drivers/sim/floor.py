@@ -99,14 +99,22 @@ def rasterise(world: World, x0: float, y0: float, resolution: float, shape: tupl
     return occupied.astype(bool)
 
 
-def reachable_floor(world: World, resolution: float = 0.05, radius: float | None = None) -> FloorGrid:
+def reachable_floor(world: World, resolution: float = 0.05, radius: float | None = None,
+                    window: tuple[float, float, float, float] | None = None) -> FloorGrid:
     """The reachable free floor of ``world`` (see the module docstring); ``radius``: the world's robot.
 
+    ``window`` ``(xmin, ymin, xmax, ymax)``: rasterise only that part of the world (it must hold
+    the start), e.g. the surroundings of the start in a large or open world; connectivity is then
+    judged within the window. Default: the world's bounds plus a margin.
     Raises ``ValueError`` when the start pose is not free for the robot's disc.
     """
     radius = world.robot_radius if radius is None else radius
     margin = radius + 4 * resolution
-    xmin, ymin, xmax, ymax = world.bounds()
+    xmin, ymin, xmax, ymax = world.bounds() if window is None else window
+    if window is not None:
+        margin = 0.0
+        if not (xmin < world.start.x < xmax and ymin < world.start.y < ymax):
+            raise ValueError(f"the window {window} does not hold the start ({world.start.x:g}, {world.start.y:g})")
     x0, y0 = xmin - margin, ymin - margin
     shape = (int(math.ceil((ymax + margin - y0) / resolution)), int(math.ceil((xmax + margin - x0) / resolution)))
     occupied = rasterise(world, x0, y0, resolution, shape)

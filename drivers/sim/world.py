@@ -368,16 +368,23 @@ def _whole_world_problems(world: World, data: YamlMap, file: str) -> list[Diagno
     return problems or _start_problems(world, data, file)
 
 
-def _start_problems(world: World, data: YamlMap, file: str) -> list[Diagnostic]:
+def free_space_problem(world: World, pose: Pose2D) -> str | None:
+    """Why the robot cannot stand at ``pose`` (too close to a wall, box or pillar), or None."""
     from drivers.sim.scene import Scene  # the scene is built from a World: imported here, not at the top
 
-    clearance = Scene(world).clearance(world.start.x, world.start.y)
+    clearance = Scene(world).clearance(pose.x, pose.y)
     if clearance >= world.robot_radius:
+        return None
+    return (f"({pose.x:g}, {pose.y:g}) is not in free space: {max(clearance, 0.0):.2f} m from a wall, box or "
+            f"pillar, less than the robot radius {world.robot_radius:g} m")
+
+
+def _start_problems(world: World, data: YamlMap, file: str) -> list[Diagnostic]:
+    problem = free_space_problem(world, world.start)
+    if problem is None:
         return []
     mark = data.value_mark_of("start") if "start" in data else data.mark
-    return [Diagnostic(file, mark.line, mark.col, f"the robot's start ({world.start.x:g}, {world.start.y:g}) is not "
-                       f"in free space: {max(clearance, 0.0):.2f} m from a wall, box or pillar, less than the robot "
-                       f"radius {world.robot_radius:g} m")]
+    return [Diagnostic(file, mark.line, mark.col, f"the robot's start {problem}")]
 
 
 def _camera_height(spec: CameraSpec, ptu: PtuSpec) -> float:

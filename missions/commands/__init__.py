@@ -8,6 +8,7 @@ COMMANDS = (
     "missions.commands.run",
     "missions.commands.validate",
     "missions.commands.show",
+    "missions.commands.import_",
     "missions.commands.schema",
     "missions.commands.bench",
     "missions.commands.sim",

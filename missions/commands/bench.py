@@ -13,7 +13,7 @@ from missions.commands.common import EXIT_INVALID, EXIT_OK
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
-        "bench", help="benchmark an area (tree, sim, perception, sweep) and print named figures",
+        "bench", help="benchmark an area (" + ", ".join(AREAS) + ") and print named figures",
         description="Measure one area and print its figures. Speeds are reported next to a reference measured "
                     "in the same run (as a ratio), so results compare across machines and runs.",
     )

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
+from drivers.sim.world_file import MAX_COORD
 from maps.store import Diagnostic, InputError
 from missions.language import MissionSpec
 from missions.loader import load_mission
+from perception.geometry import Pose2D
 
 EXIT_OK, EXIT_FAILURE, EXIT_INVALID = 0, 1, 2
 
@@ -52,3 +55,26 @@ def fail(command: str, message: str) -> int:
     """Report invalid input of a sub-command in one line on stderr; the exit code for it."""
     print(f"bearings {command}: {message}", file=sys.stderr)
     return EXIT_INVALID
+
+
+def parse_pose(text: str, named: dict[str, Pose2D], *, option: str) -> Pose2D:
+    """``x,y,theta`` (theta in rad, or degrees with a ``deg`` suffix) or a named pose of a world."""
+    if text in named:
+        return named[text]
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) not in (2, 3):
+        known = ", ".join(sorted(named)) or "none"
+        raise ValueError(f"{option} must be x,y,theta or a named pose (this world has: {known}), got {text!r}")
+    try:
+        x, y = float(parts[0]), float(parts[1])
+        theta = 0.0
+        if len(parts) == 3:
+            raw = parts[2].lower()
+            theta = math.radians(float(raw[:-3])) if raw.endswith("deg") else float(raw)
+    except ValueError:
+        raise ValueError(f"{option}: numbers expected in x,y,theta, got {text!r}") from None
+    if not all(math.isfinite(v) for v in (x, y, theta)):
+        raise ValueError(f"{option}: finite numbers expected, got {text!r}")
+    if max(abs(x), abs(y)) > MAX_COORD:
+        raise ValueError(f"{option}: x and y must be within {MAX_COORD:g} m (the extent of any world), got {text!r}")
+    return Pose2D(x, y, theta)

@@ -17,6 +17,7 @@ import tempfile
 from collections.abc import Iterator
 from concurrent.futures import Executor
 from pathlib import Path
+from typing import Any
 
 from maps.store import InputError
 from missions.commands.common import EXIT_FAILURE, EXIT_OK, fail, print_input_error
@@ -29,7 +30,8 @@ MAX_SEEDS = 10_000
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
-        "eval", help="evaluate an area (exploration) in a simulated world over seeds and print named figures",
+        "eval", help=f"evaluate an area ({', '.join(sorted(AREAS))}) in a simulated world over seeds and print "
+                     "named figures",
         description="Run an area's evaluation episodes through the sweep runner and print one JSON object of "
                     "named figures (--json) or a table. Works on any world file the simulator reads.",
     )
@@ -44,6 +46,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("-o", "--output", type=Path, metavar="DIR", help="keep the sweep's results here")
     parser.add_argument("--resume", action="store_true", help="with -o: reuse the episodes DIR already has")
     parser.add_argument("--progress", action="store_true", help="progress on stderr even when not a terminal")
+    parser.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
+                        help="an option of the area (repeatable), e.g. ltmap: camera=landmarks")
     parser.add_argument("--json", action="store_true", help="print one JSON object (default: a table)")
     parser.set_defaults(func=run)
 
@@ -77,6 +81,24 @@ def _problem(args: argparse.Namespace) -> str | None:
     return None
 
 
+def area_options(module: Any, area: str, given: list[str]) -> dict[str, str]:
+    """``--option NAME=VALUE`` texts as a mapping; ``ValueError`` for a malformed, repeated or unknown name."""
+    known: dict[str, str] = getattr(module, "OPTIONS", {})
+    extra: dict[str, str] = {}
+    for text in given:
+        name, equals, value = text.partition("=")
+        name = name.strip()
+        if not equals or not name:
+            raise ValueError(f"--option must be NAME=VALUE, got {text!r}")
+        if name not in known:
+            has = ", ".join(sorted(known)) or "none"
+            raise ValueError(f"--option: the {area} evaluation has no option {name!r} (its options: {has})")
+        if name in extra:
+            raise ValueError(f"--option {name} is given twice")
+        extra[name] = value.strip()
+    return extra
+
+
 def run(args: argparse.Namespace) -> int:
     problem = _problem(args)
     if problem:
@@ -84,6 +106,9 @@ def run(args: argparse.Namespace) -> int:
     module = importlib.import_module(AREAS[args.area])
     try:
         module.check_world(args.world)
+        extra = area_options(module, args.area, args.option)
+        if hasattr(module, "check_options"):
+            module.check_options(args.world, extra)
     except InputError as exc:
         return print_input_error(exc)
     except ValueError as exc:
@@ -93,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             executor = stack.enter_context(_executor(args))
             options = EvalOptions(args.world, list(range(args.seeds)), executor, folder, args.timeout,
-                                  args.max_time, progress_stream(args.progress))
+                                  args.max_time, progress_stream(args.progress), extra)
             figures = module.run(options, resume=args.resume)
         except SweepInputError as exc:
             return fail("eval", str(exc))

@@ -12,10 +12,11 @@ from drivers.interfaces import Robot
 from maps.located import validate
 from maps.store import Diagnostic, InputError, output_problem, write_json
 from missions.clocks import Paced, WallClock
-from missions.commands.common import add_mission_options, load_from_args, print_input_error
+from missions.commands.common import add_mission_options, load_from_args, parse_pose, print_input_error
 from missions.model import RunArguments
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
+from perception.geometry import Pose2D
 
 DESCRIPTION = """Run a mission until its tree ends in SUCCESS or FAILURE.
 
@@ -42,6 +43,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                        help="simulate in WORLD (shipped name or world file; default: empty plane)")
     where.add_argument("--robot", metavar="ROBOT.yaml", help="run on the robot described by this profile")
     parser.add_argument("--seed", type=int, default=0, help="simulator seed, 0 to 4294967295 (default 0)")
+    parser.add_argument("--start", metavar="POSE", help="simulator only: the robot's true start pose, x,y,theta "
+                        "(theta in rad, or with a deg suffix) or a named pose of the world (default: its start)")
     parser.add_argument("--report", type=Path, metavar="F.json",
                         help="write the run report (JSON) here; a missing folder is created")
     parser.add_argument("--save", type=Path, metavar="F.rrd",
@@ -140,15 +143,36 @@ def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock]:
     if args.robot:
         from missions.profiles import open_robot
 
+        if args.start:
+            raise InputError([Diagnostic("--start", 0, 0, "sets the simulated robot's start; a real robot starts "
+                                         "where it stands")])
         clock = WallClock()  # one time axis for the drivers' stamps and the tree
         try:
             return None, open_robot(args.robot, clock=clock.now), clock
         except OSError as exc:
             raise InputError([Diagnostic(args.robot, 0, 0, f"cannot open the robot: {exc}")]) from None
     from drivers.sim.simulation import Simulation
+    from drivers.sim.world import load_world
 
     try:
-        simulation = Simulation.load(args.sim, seed=seed)
+        world = load_world(args.sim)
     except (OSError, ValueError) as exc:  # InputError (a bad world file) passes through as it is
         raise InputError([Diagnostic(str(args.sim), 0, 0, str(exc))]) from None
+    simulation = Simulation(world, seed=seed, start=_start_pose(args.start, world))
     return simulation, simulation.robot, simulation.clock()
+
+
+def _start_pose(text: str | None, world: Any) -> Pose2D | None:
+    """The ``--start`` pose in the world (named or x,y,theta), checked to be in free space."""
+    if text is None:
+        return None
+    from drivers.sim.world import free_space_problem
+
+    try:
+        pose = parse_pose(text, {"start": world.start, **world.poses}, option="--start")
+    except ValueError as exc:
+        raise InputError([Diagnostic("--start", 0, 0, str(exc).removeprefix("--start: "))]) from None
+    problem = free_space_problem(world, pose)
+    if problem:
+        raise InputError([Diagnostic("--start", 0, 0, f"the pose {problem}")])
+    return pose

@@ -28,9 +28,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     try:
         mission = load_from_args(args.mission, args)
+        text = FORMATS[args.format](mission)  # the XML export refuses what BT.CPP cannot express
     except InputError as exc:
         return print_input_error(exc)
-    text = FORMATS[args.format](mission)
     if args.output:
         write_text_atomic(args.output, text)
     else:

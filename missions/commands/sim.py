@@ -13,12 +13,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from drivers.sim.world_file import MAX_COORD
 from maps.located import validate
 from maps.store import InputError, write_bytes_atomic
-from missions.commands.common import EXIT_INVALID, EXIT_OK, fail, print_input_error
+from missions.commands.common import EXIT_INVALID, EXIT_OK, fail, parse_pose, print_input_error
 from missions.model import RunArguments
-from perception.geometry import Pose2D
 
 SNAPSHOT_DESCRIPTION = """Render the image a simulated camera sees with the robot at a given TRUE pose, and
 write it as an image file (PNG, or any format OpenCV writes, chosen by the file extension). A stereo
@@ -75,29 +73,6 @@ def _help(parser: argparse.ArgumentParser) -> int:
 
 
 
-def parse_pose(text: str, named: dict) -> Pose2D:
-    """``x,y,theta`` (theta in rad, or degrees with a ``deg`` suffix) or a named pose."""
-    if text in named:
-        return named[text]
-    parts = [p.strip() for p in text.split(",")]
-    if len(parts) not in (2, 3):
-        known = ", ".join(sorted(named)) or "none"
-        raise ValueError(f"--pose must be x,y,theta or a named pose (this world has: {known}), got {text!r}")
-    try:
-        x, y = float(parts[0]), float(parts[1])
-        theta = 0.0
-        if len(parts) == 3:
-            raw = parts[2].lower()
-            theta = math.radians(float(raw[:-3])) if raw.endswith("deg") else float(raw)
-    except ValueError:
-        raise ValueError(f"--pose: numbers expected in x,y,theta, got {text!r}") from None
-    if not all(math.isfinite(v) for v in (x, y, theta)):
-        raise ValueError(f"--pose: finite numbers expected, got {text!r}")
-    if max(abs(x), abs(y)) > MAX_COORD:
-        raise ValueError(f"--pose: x and y must be within {MAX_COORD:g} m (the extent of any world), got {text!r}")
-    return Pose2D(x, y, theta)
-
-
 def run_snapshot(args: argparse.Namespace) -> int:
     from drivers.sim.simulation import Simulation
 
@@ -108,7 +83,7 @@ def run_snapshot(args: argparse.Namespace) -> int:
         return print_input_error(exc)
     named = {"start": sim.world.start, **sim.world.poses}
     try:
-        pose = parse_pose(args.pose, named)
+        pose = parse_pose(args.pose, named, option="--pose")
     except ValueError as exc:
         return fail("sim", str(exc))
     if args.camera not in sim.cameras:

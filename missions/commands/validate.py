@@ -10,7 +10,7 @@ from missions.commands.common import EXIT_INVALID, EXIT_OK, add_mission_options,
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
-        "validate", help="check mission files (syntax, node types, parameters, includes)",
+        "validate", help="check mission files (syntax, node types, ports, data flow, includes)",
         description="Load and check each mission as 'run' would, without running it. Every problem of every "
                     "file is reported as file:line:col: message. Exit 0 when all are valid, 2 otherwise.",
     )

@@ -1,22 +1,31 @@
 """Evaluations behind ``bearings eval AREA``: one module per area, run through the sweep runner.
 
-An area module exposes ``DESCRIPTION`` (one line), ``run(options: EvalOptions) -> dict`` (one JSON
-object of named figures) and ``format_table(figures) -> str`` (the readable form). Every episode
-goes through :func:`missions.sweep.run_sweep` with the executor the command built (a local process
-pool or a Dask cluster), on any world file the simulator reads. Evaluations may use the simulator's
-ground truth (the run reports' ``ground_truth`` sections); the behaviours they evaluate never do.
+An area module exposes ``DESCRIPTION`` (one line), ``check_world(world)`` (raises ``InputError`` or
+``ValueError`` for a world it cannot evaluate), ``run(options: EvalOptions, *, resume: bool) -> dict``
+(one JSON object of named figures) and ``format_table(figures) -> str`` (the readable form). Every
+episode goes through :func:`missions.sweep.run_sweep` with the executor the command built (a local
+process pool or a Dask cluster), on any world file the simulator reads. Evaluations may use the
+simulator's ground truth (the run reports' ``ground_truth`` sections); the behaviours they evaluate
+never do.
+
+An area with options of its own declares them in ``OPTIONS`` (name -> one-line help). The command
+takes them as ``--option NAME=VALUE`` (repeatable; a name the area does not declare is refused) and
+passes them on as text in :attr:`EvalOptions.extra`; when the module has ``check_options(world,
+extra)``, that may refuse a bad value (``ValueError``, exit 2) before any episode runs.
+
 To add an area, write its module and name it in :data:`AREAS`.
 """
 
 from __future__ import annotations
 
 from concurrent.futures import Executor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TextIO
 
 AREAS = {
     "exploration": "missions.eval.exploration",
+    "ltmap": "missions.eval.ltmap",
 }
 
 
@@ -31,3 +40,4 @@ class EvalOptions:
     timeout_s: float | None = None  # wall-clock limit per episode
     max_time_s: float | None = None  # each episode's --max-time (simulated seconds); None: the mission's
     progress: TextIO | None = None
+    extra: dict[str, str] = field(default_factory=dict)  # the area's own options (--option NAME=VALUE)

@@ -37,14 +37,16 @@ class SweepInputError(ValueError):
 class Episode:
     """One ``bearings run``: ``mission`` (file or shipped name), ``world`` (shipped name or file,
     ``"empty"`` for the empty plane), ``seed``, ``inputs`` (``--set name=value``; values are YAML
-    text as on the command line, or plain scalars) and ``max_time_s`` (the run's ``--max-time``,
-    simulated seconds; None: the mission's own limit)."""
+    text as on the command line, or plain scalars), ``max_time_s`` (the run's ``--max-time``,
+    simulated seconds; None: the mission's own limit) and ``start`` (the run's ``--start``: a
+    start pose ``x,y,theta`` or a named pose of the world; None: the world's start)."""
 
     mission: str
     world: str = "empty"
     seed: int = 0
     inputs: Mapping[str, Any] = field(default_factory=dict)
     max_time_s: float | None = None
+    start: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inputs", {str(k): v for k, v in sorted(dict(self.inputs).items())})
@@ -60,8 +62,11 @@ class Episode:
     @property
     def parameters(self) -> dict[str, Any]:
         """Everything the episode's outcome depends on (the id hashes exactly this)."""
-        return {"mission": str(self.mission), "world": str(self.world), "seed": int(self.seed),
-                "inputs": self.input_text, "max_time_s": self.max_time_s}
+        parameters = {"mission": str(self.mission), "world": str(self.world), "seed": int(self.seed),
+                      "inputs": self.input_text, "max_time_s": self.max_time_s}
+        if self.start is not None:  # only when given: the ids of earlier sweeps stay what they were
+            parameters["start"] = self.start
+        return parameters
 
     @property
     def id(self) -> str:
@@ -73,6 +78,8 @@ class Episode:
         parts.append(f"s{self.seed:04d}")
         if self.max_time_s is not None:
             parts.append(f"t{self.max_time_s:g}")
+        if self.start is not None:
+            parts.append(f"at={safe_name(self.start)}")
         return "_".join(parts) + f"_{digest}"
 
     @property
@@ -88,6 +95,8 @@ class Episode:
             argv += ["--set", f"{name}={text}"]
         if self.max_time_s is not None:
             argv += ["--max-time", repr(float(self.max_time_s))]
+        if self.start is not None:
+            argv.append(f"--start={self.start}")  # '=': a pose may start with a minus sign
         return argv
 
 

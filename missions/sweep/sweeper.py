@@ -171,7 +171,7 @@ def check_episodes(episodes: Sequence[Episode], executor: Executor, *, timeout_s
     own per-run limit)."""
     checks: dict[tuple, Episode] = {}
     for e in episodes:
-        probe = Episode(e.mission, e.world, e.seed, e.inputs, CHECK_TIME_S)
+        probe = Episode(e.mission, e.world, e.seed, e.inputs, CHECK_TIME_S, e.start)
         checks.setdefault(("world", e.mission, e.world), probe)
         checks.setdefault(("inputs", e.mission, tuple(e.input_text.items())), probe)
     probes = list(dict.fromkeys(checks.values()))

@@ -112,14 +112,25 @@ def prune_step(tree: LandmarkTree, data: st.DataObject) -> None:
     kept = step.landmark_index >= 0
     assert np.array_equal(tree.ids[step.landmark_index[kept]], before_ids[kept])
     assert np.count_nonzero(kept) == tree.landmark_count
+    check_viewframe_index(step.viewframe_index, before_sets, tree)
+
+
+def check_viewframe_index(index: np.ndarray, before_sets: list[frozenset[int]], tree: LandmarkTree) -> None:
+    """Every old viewframe maps to the one it became (its surviving landmarks are there) or to -1."""
+    sets, surviving = all_sets(tree), frozenset(tree.ids.tolist())
+    assert len(index) == len(before_sets) and index[0] == 0, "the start stays the start"
+    assert set(index[index >= 0].tolist()) == set(range(len(sets))), "every new viewframe comes from an old one"
+    for old, new in enumerate(index.tolist()):
+        assert new < 0 or before_sets[old] & surviving <= sets[new]
 
 
 def budget_step(tree: LandmarkTree, data: st.DataObject) -> None:
     budget = int(tree.memory_bytes() * data.draw(st.floats(0.0, 1.2), label="budget fraction"))
-    before = tree.to_arrays()
+    before, before_sets = tree.to_arrays(), all_sets(tree)
     report = tree.prune_to(budget, data.draw(st.integers(0, 30), label="min landmarks"))
     if report.fits:
         assert tree.memory_bytes() <= budget and report.bytes_after == tree.memory_bytes()
+        check_viewframe_index(report.viewframe_index, before_sets, tree)
     else:
         assert same_arrays(tree.to_arrays(), before), "a budget it cannot meet leaves the map as it was"
         assert report.smallest_bytes > budget and report.bytes_after == report.bytes_before

@@ -158,5 +158,5 @@ def test_every_shipped_mission_exports_typed_input_and_output_ports(path):
     drive = root.find(".//TreeNodesModel/Action[@ID='Drive']")
     if drive is not None:
         command = drive.find("output_port[@name='command']")
-        assert command.get("type") == "VelocityCommand" and command.get("default") == "{/robot/command}"
+        assert command.get("type") == "VelocityCommand" and command.get("default") == "{@robot__command}"
         assert drive.find("input_port[@name='distance']").get("type") == "double"

@@ -181,3 +181,16 @@ def test_a_foreign_file_is_named_in_one_short_line(capsys):
     assert main(["sim", "snapshot", "--world", "/etc/passwd", "--pose", "1,1", "-o", "/tmp/never.png"]) == 2
     [line, _count] = capsys.readouterr().err.splitlines()
     assert line.startswith("/etc/passwd:1:1: a world file must be a mapping") and len(line) < 160
+
+
+def test_a_simulated_run_starts_where_told_and_only_in_free_space(tmp_path, capsys):
+    report = tmp_path / "r.json"
+    assert main(["run", "square", "--sim", "lab", "--start=4.2,3.2,90deg", "--quiet", "--report", str(report),
+                 "--max-time", "0.5"]) == 1
+    first = json.loads(report.read_text())["ground_truth"]["trajectory"][0]
+    assert first[1:3] == pytest.approx([4.2, 3.2]) and first[3] == pytest.approx(1.5708, abs=1e-4)
+    for start, expected in (("0.1,0.1,0", "--start: the pose (0.1, 0.1) is not in free space"),
+                            ("nowhere", "--start must be x,y,theta or a named pose"),
+                            ("1e9,0", "--start: x and y must be within 10000 m")):
+        assert main(["run", "square", "--sim", "lab", f"--start={start}", "--quiet"]) == 2
+        assert expected in capsys.readouterr().err, start

@@ -217,14 +217,14 @@ def test_exits_raised_by_a_behaviour_end_the_run_with_a_report(write_mission, tm
 
 
 def test_a_signal_before_the_loop_starts_is_reported(write_mission, tmp_path, monkeypatch):
-    from drivers.sim.simulation import Simulation
+    from drivers.sim import world
 
     def interrupted_load(*_args, **_kwargs):
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(1.0)  # the handler interrupts this
         raise AssertionError("not interrupted")
 
-    monkeypatch.setattr(Simulation, "load", interrupted_load)
+    monkeypatch.setattr(world, "load_world", interrupted_load)  # loading the world: before the loop
     report = tmp_path / "report.json"
     assert main(["run", "square", "--quiet", "--report", str(report)]) == 130
     data = json.loads(report.read_text())

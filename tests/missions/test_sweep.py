@@ -246,3 +246,11 @@ def test_bench_sweep_prints_named_figures(capsys):
         assert figures[key] > 0
     expected = figures["episodes_per_s_n_workers"] / (figures["workers"] * figures["episodes_per_s_1_worker"])
     assert abs(figures["scaling_ratio"] - expected) < 0.01
+
+
+def test_an_episode_can_start_at_a_chosen_pose():
+    from missions.sweep import Episode
+
+    plain, placed = Episode("square", "lab", 1), Episode("square", "lab", 1, start="4.2,3.2,90deg")
+    assert plain.id != placed.id and "start" not in plain.parameters
+    assert placed.run_arguments("r.json")[-1] == "--start=4.2,3.2,90deg"

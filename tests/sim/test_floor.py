@@ -87,3 +87,17 @@ def test_the_rooms_world_is_four_rooms_joined_by_doors():
     rows, cols, inside = floor.cells_of(centres)
     assert inside.all() and floor.reachable[rows, cols].all()
     assert 50.0 < floor.reachable_area < 62.0  # of 96 m^2 inside the outer walls
+
+
+def test_a_window_rasterises_only_the_floor_around_the_start(world_file):
+    world = load_world(world_file(ROOM))
+    whole = reachable_floor(world, resolution=0.02)
+    part = reachable_floor(world, resolution=0.02, window=(-0.5, -0.5, 2.0, 3.5))  # the room's left half
+    assert part.reachable.shape == (200, 125)
+    assert part.reachable_area == pytest.approx(1.75 * 2.5 - math.pi * 0.45**2, rel=0.03)  # walls and pillar
+    assert part.reachable_area < whole.reachable_area and not part.bounded  # open at x = 2
+    plane = load_world(world_file("start: {x: 100.0, y: -50.0}\n"))  # no walls: only the window bounds it
+    around = reachable_floor(plane, resolution=0.1, window=(95.0, -55.0, 105.0, -45.0))
+    assert around.reachable.all() and not around.bounded
+    with pytest.raises(ValueError, match="does not hold the start"):
+        reachable_floor(world, window=(2.0, 0.0, 4.0, 3.0))

@@ -1,0 +1,156 @@
+"""The LT-map on the blackboard: load it from a file, prune it to a memory budget.
+
+The map of a taught route (:class:`maps.ltmap.LandmarkTree`, DESIGN.md algorithm 1) travels
+between nodes on ``/map/ltmap``: ``LearnRoute`` (:mod:`behaviours.teach`) or :class:`LoadMap`
+write it, :class:`PruneMap` shrinks it, the route-following nodes (:mod:`behaviours.route`,
+:mod:`behaviours.search`) read it. The file path is a literal port, so missions pass it as an
+input (``path: "${map}"``) and ``--set map=...`` picks another file.
+
+Both nodes add to the report's ``ltmap`` section (:meth:`report_sections`): the map's shape and
+size, and for a pruned map the memory it kept and where each of its viewframes came from
+(``viewframe_source``: the index in the loaded map), so an evaluation can compare a viewframe
+reached while following a pruned map with the place it was taught.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+
+from behaviours.base import BearingsBehaviour
+from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.registry import register
+from maps.ltmap import DEFAULT_MIN_LANDMARKS, LandmarkTree, MapSummary
+from maps.ltmap_file import load_ltmap, save_ltmap
+from maps.store import InputError
+
+LTMAP_KEY = "/map/ltmap"
+LTMAP_IN = InputPort("ltmap", LandmarkTree, Ref(LTMAP_KEY), doc="the LT-map of the taught route")
+LTMAP_OUT = OutputPort("ltmap", LandmarkTree, LTMAP_KEY, doc="the LT-map of the taught route")
+
+
+def summary_section(summary: MapSummary) -> dict[str, Any]:
+    """The map's figures as the report's ``ltmap`` section holds them."""
+    return {
+        "landmark_kind": summary.kind,
+        "viewframes": summary.viewframes,
+        "landmarks": summary.landmarks,
+        "nodes": summary.nodes,
+        "height": summary.height,
+        "bytes": summary.memory_bytes,
+        "landmarks_per_level": list(summary.landmarks_per_level),
+        "threshold": summary.threshold,
+    }
+
+
+def save_map(path: str, tree: LandmarkTree) -> None:
+    """Save atomically (a failed save keeps the previous file): the one way the nodes write maps."""
+    save_ltmap(path, tree)
+
+
+@register
+class LoadMap(BearingsBehaviour):
+    """Load an LT-map file onto the blackboard; FAILURE (with the file's problem) when it cannot.
+
+    Loads once per run of the node (a mission that loads the same map twice reads it twice);
+    the file is checked whole (version, checksum, tree consistency) before anything follows it.
+    """
+
+    PORTS = (
+        InputPort("path", str, doc="the LT-map file (a mission input: --set map=route.ltmap)", literal_only=True),
+        LTMAP_OUT,
+    )
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
+        super().__init__(name=name, **ports)
+        self.summary: MapSummary | None = None
+
+    def update(self) -> Status:
+        path = str(self.get_input("path"))
+        try:
+            tree = load_ltmap(path)
+        except (InputError, OSError) as exc:
+            self.feedback_message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            return Status.FAILURE
+        if tree.viewframe_count == 0:
+            self.feedback_message = f"{path}: the map has no viewframes"
+            return Status.FAILURE
+        self.summary = tree.summary()
+        self.set_output("ltmap", tree)
+        self.feedback_message = f"{tree.viewframe_count} viewframes, {tree.memory_bytes()} bytes"
+        return Status.SUCCESS
+
+    def report_sections(self) -> dict[str, dict[str, Any]]:
+        if self.summary is None:
+            return {}
+        return {"ltmap": {"map_file": str(self.get_input("path")), **summary_section(self.summary)}}
+
+
+@register
+class PruneMap(BearingsBehaviour):
+    """Cut the lowest levels of the LT-map until it fits a memory budget (the paper's Table I).
+
+    The budget is ``budget`` bytes, or ``fraction`` of the map's size when it arrives (the
+    smaller of the two when both are given; 0 and 1 mean no limit). FAILURE, with the map left
+    as it was, when even a single level exceeds the budget. The pruned map replaces the input
+    on the blackboard (``ltmap`` output, the same key by default); with ``path`` it is also
+    saved atomically.
+    """
+
+    PORTS = (
+        InputPort("budget", int, 0, unit="B", minimum=0, doc="memory budget in bytes; 0: none"),
+        InputPort("fraction", float, 1.0, minimum=0.0, maximum=1.0,
+                  doc="memory budget as a fraction of the map's size; 1: none"),
+        InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0,
+                  doc="viewframes left with fewer landmarks are deleted (the paper: 50, enough for homing)"),
+        InputPort("path", str, "", literal_only=True, doc="save the pruned map here too (empty: do not save)"),
+        InputPort("source", LandmarkTree, Ref(LTMAP_KEY), doc="the LT-map to prune"),
+        LTMAP_OUT,
+    )
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
+        super().__init__(name=name, **ports)
+        self.section: dict[str, Any] = {}
+
+    def budget_bytes(self, size: int) -> int | None:
+        """The budget for a map of ``size`` bytes, or None for no limit."""
+        limits = []
+        budget, fraction = int(self.get_input("budget")), float(self.get_input("fraction"))
+        if budget > 0:
+            limits.append(budget)
+        if fraction < 1.0:
+            limits.append(math.floor(fraction * size))
+        return min(limits) if limits else None
+
+    def update(self) -> Status:
+        tree: LandmarkTree | None = self.get_input("source", None)
+        if tree is None:
+            self.feedback_message = "no LT-map to prune"
+            return Status.FAILURE
+        before = tree.memory_bytes()
+        budget = self.budget_bytes(before)
+        pruned = tree.copy()  # the input stays as it was for whoever else holds it
+        source = np.arange(tree.viewframe_count)
+        if budget is not None:
+            report = pruned.prune_to(budget, int(self.get_input("min_landmarks")))
+            if not report.fits:
+                self.feedback_message = f"{report.smallest_bytes} bytes at the least, over the {budget} byte budget"
+                return Status.FAILURE
+            source = np.array([int(np.flatnonzero(report.viewframe_index == k)[0])
+                               for k in range(pruned.viewframe_count)], dtype=np.int64)
+        path = str(self.get_input("path"))
+        if path:
+            save_map(path, pruned)
+        self.set_output("ltmap", pruned)
+        after = pruned.memory_bytes()
+        self.section = {**summary_section(pruned.summary()), "bytes_before_pruning": before,
+                        "memory_fraction": round(after / before, 4) if before else 1.0,
+                        "viewframe_source": source.tolist()}
+        self.feedback_message = f"{before} -> {after} bytes, {pruned.viewframe_count} viewframes"
+        return Status.SUCCESS
+
+    def report_sections(self) -> dict[str, dict[str, Any]]:
+        return {"ltmap": dict(self.section)} if self.section else {}

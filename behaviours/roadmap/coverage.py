@@ -1,0 +1,129 @@
+"""Coverage scoring: the next position to search from (DESIGN.md, algorithm 2, "Coverage").
+
+The configuration space (x, y at 10 cm, heading at 5 degrees) inside the room's free space is
+covered by the images taken at search positions; the next position is the one whose 12 images
+would newly cover the most configurations without fragmenting what is left
+(:func:`maps.coverage.choose_next`). This node keeps the coverage grid: it builds it from the room
+estimate the first time, marks what each scan covered (``scan``, written by ``ScanForTargets``:
+the position and the headings of the images actually taken, so a scan stopped early by a match
+leaves the rest of that position to cover), then chooses.
+
+Choices where the paper is vague:
+
+- Candidates are the valid positions in the robot's own free region
+  (:func:`maps.coverage.reachable_positions`); when the robot stands where the grid says it
+  cannot (just after homing close to furniture), every valid position is a candidate.
+- The search ends (FAILURE, "nothing left to cover") when the best position would newly cover
+  fewer than ``min_new`` configurations (default 100: under a tenth of what a fresh position
+  covers in the lab).
+- The goal's heading is the direction of travel to it, so getting there needs no final turn.
+- A goal given out and not followed by a scan (this node ticks again with no new ``scan``:
+  the travel there failed) is taken as unreachable: positions within 0.3 m of it are no longer
+  candidates. Otherwise the same best position would be chosen, and failed, round after round.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+
+from behaviours.base import BearingsBehaviour
+from behaviours.motion import ODOMETRY
+from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.registry import register
+from behaviours.roadmap.display import RoadmapDisplay
+from behaviours.roadmap.values import ScanRecord
+from maps.coverage import FRAGMENT_COST, CoverageGrid, choose_next, coverage_grid, reachable_positions
+from maps.room import RoomEstimate
+from perception.geometry import Pose2D
+
+UNREACHABLE_RADIUS = 0.3  # m around a goal the robot did not reach: not a candidate again
+
+
+@register
+class CoverageScoring(BearingsBehaviour):
+    """Choose the next search position: the most newly covered configurations, least fragmentation.
+
+    Marks the last scan's images as covered, then writes the chosen position (``goal``,
+    reference frame) and the coverage grid. FAILURE when nothing worth a visit is left.
+    """
+
+    PORTS = (
+        InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate"),
+        InputPort("scan", ScanRecord, Ref("/map/scan"), doc="the images of the last scan (none yet: nothing)"),
+        InputPort("robot_radius", float, 0.28, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
+                  doc="radius of the disc the robot occupies (with a margin)"),
+        InputPort("min_new", int, 100, minimum=1, literal_only=True,
+                  doc="fewest newly covered configurations that make a position worth a visit"),
+        InputPort("fragment_cost", float, FRAGMENT_COST, minimum=0.0, literal_only=True,
+                  doc="configurations one more uncovered fragment is worth"),
+        ODOMETRY,
+        OutputPort("coverage", CoverageGrid, "/map/coverage", doc="the coverage grid"),
+        OutputPort("goal", Pose2D, "/map/coverage_goal", doc="the next search position (reference frame)"),
+    )
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
+        super().__init__(name=name, **ports)
+        self.grid: CoverageGrid | None = None
+        self.applied: set[int] = set()
+        self.pending: Pose2D | None = None  # the last goal given, until a scan from it arrives
+        self.unreachable: list[Pose2D] = []
+        self.choices = 0
+        self.display = RoadmapDisplay()
+
+    def update(self) -> Status:
+        room: RoomEstimate | None = self.get_input("room", None)
+        odometry: Pose2D | None = self.get_input("odometry", None)
+        if room is None or odometry is None:
+            self.feedback_message = "no room estimate" if room is None else "waiting for odometry"
+            return Status.FAILURE if room is None else Status.RUNNING
+        radius = float(self.get_input("robot_radius"))
+        grid = self.grid or coverage_grid(room, room.free, robot_radius=radius)
+        scan: ScanRecord | None = self.get_input("scan", None)
+        if scan is not None and scan.seq not in self.applied:
+            self.applied.add(scan.seq)
+            grid = grid.cover(scan.x, scan.y, scan.headings)  # the headings actually imaged
+            self.pending = None
+        if self.pending is not None:  # asked for again with no scan since: the robot did not get there
+            self.unreachable.append(self.pending)
+        self.grid = grid
+        self.set_output("coverage", grid)
+        here = room.to_reference(odometry)
+        candidates = reachable_positions(grid, room.free, radius, here.x, here.y)
+        candidates = self._without_unreachable(grid, candidates if candidates.any() else grid.valid)
+        choice = choose_next(grid, candidates=candidates,
+                             min_new=int(self.get_input("min_new")),
+                             fragment_cost=float(self.get_input("fragment_cost")))
+        if choice is None:
+            self.feedback_message = f"nothing left to cover ({100 * grid.fraction_covered:.0f} % covered)"
+            return Status.FAILURE
+        self.choices += 1
+        self.pending = Pose2D(choice.x, choice.y, math.atan2(choice.y - here.y, choice.x - here.x))
+        self.set_output("goal", self.pending)
+        self.feedback_message = (f"position {self.choices} at ({choice.x:.1f}, {choice.y:.1f}): {choice.new} new, "
+                                 f"{100 * grid.fraction_covered:.0f} % covered")
+        return Status.SUCCESS
+
+    def _without_unreachable(self, grid: CoverageGrid, candidates: np.ndarray) -> np.ndarray:
+        """The candidates farther than ``UNREACHABLE_RADIUS`` from every goal the robot did not reach."""
+        if not self.unreachable:
+            return candidates
+        ix, iy = np.indices(grid.valid.shape)
+        x, y = grid.origin[0] + ix * grid.cell, grid.origin[1] + iy * grid.cell
+        keep = candidates.copy()
+        for goal in self.unreachable:
+            keep &= np.hypot(x - goal.x, y - goal.y) > UNREACHABLE_RADIUS
+        return keep
+
+    def report_sections(self) -> dict[str, Any]:
+        if self.grid is None:
+            return {}
+        return {"roadmap": {"search": {"positions_chosen": self.choices, "scans": len(self.applied),
+                                       "unreachable": len(self.unreachable),
+                                       "covered_fraction": round(self.grid.fraction_covered, 4)}}}
+
+    def log_rerun(self, rec: Any) -> None:
+        self.display.log_coverage(rec, self.grid)

@@ -1,0 +1,166 @@
+"""Navigating the roadmap to a target from an unknown pose (DESIGN.md, algorithm 2, "Navigation").
+
+Paper: rotate and try to match any graph image; when none matches, move randomly and retry;
+then take the shortest path (edge cost sigma_x + sigma_y), homing at each node to remove drift.
+
+1. **Localise**: scan (12 images turning on the spot, :func:`behaviours.roadmap.scan.scan`) for
+   any target of the roadmap; home to the one matched. Nothing matched (or homing lost it): a
+   random move, then scan again, at most ``max_random_moves`` times.
+2. **Path**: :meth:`maps.roadmap.Roadmap.shortest_path` from the target homed at to the goal.
+3. **Edges**: each edge is replayed as stored, ``Rotate(angle1)``, ``Drive(distance)``,
+   ``Rotate(angle2)`` (odometry units: the robot's odometry errors replay the way they were
+   learned), then homing to the edge's target removes the drift. A failed edge (a stall, the
+   target not found at its end) sends the robot back to step 1 and a new path.
+
+Choices where the paper is vague:
+
+- **Random move**: a turn drawn uniformly in [-180, 180) degrees, then a straight drive of a length
+  drawn in ``random_distance`` (0.4-1.2 m); a stall (the move ran into something) backs off
+  0.2 m and counts as the move. Draws come from ``seed``, so a run is repeatable.
+- **Start at the goal's image**: when the first target matched is the goal, homing to it is the
+  whole navigation.
+- **Success** means homed at the goal: within homing's ``done_distance`` of where the goal image
+  was taken, facing as it does.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.registry import register
+from behaviours.roadmap.display import RoadmapDisplay
+from behaviours.roadmap.homing import HOMING_PORTS, HomingSettings, home
+from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.scan import scan
+from behaviours.roadmap.values import NavigationResult, TargetImages
+from maps.roadmap import EdgeMotion, Roadmap
+
+
+@register
+class NavigateToTarget(RoutineBehaviour):
+    """From an unknown pose, reach a target of the roadmap: match a target (random moves until one
+    matches), then follow the shortest path, homing at every node. Writes how it went (``navigation``)."""
+
+    PORTS = (
+        InputPort("target", str, doc="name of the target to reach"),
+        InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the learned roadmap"),
+        InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the roadmap's target images"),
+        InputPort("images", int, 12, minimum=1, maximum=72, literal_only=True,
+                  doc="images per localisation scan, evenly spaced over a full turn"),
+        InputPort("max_random_moves", int, 12, minimum=0, maximum=1000, literal_only=True,
+                  doc="random moves before giving up when no target matches"),
+        InputPort("random_distance", list[float], [0.4, 1.2], unit="m", literal_only=True,
+                  doc="shortest and longest random move"),
+        InputPort("seed", int, 0, minimum=0, literal_only=True, doc="seed of the random moves"),
+        *HOMING_PORTS,
+        *ROUTINE_PORTS,
+        OutputPort("navigation", NavigationResult, "/map/navigation", doc="how the navigation went"),
+    )
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
+        super().__init__(name=name, **ports)
+        low_high = self.inputs["random_distance"]
+        if len(low_high) != 2 or not 0 <= low_high[0] <= low_high[1]:
+            raise ValueError(f"NavigateToTarget.random_distance takes [shortest, longest], got {low_high}")
+        self.result: NavigationResult | None = None
+        self.rng = np.random.default_rng(0)
+        self.display = RoadmapDisplay()
+
+    def routine(self) -> Step[None]:
+        goal = str(self.get_input("target"))
+        roadmap: Roadmap | None = self.get_input("roadmap", None)
+        targets: TargetImages | None = self.get_input("targets", None)
+        if roadmap is None or targets is None:
+            raise Failed("no roadmap" if roadmap is None else "no target images")
+        if not goal:
+            raise Failed("no target given (goto_target: --set target=NAME)")
+        if goal not in roadmap.names or goal not in targets.names:
+            raise Failed(f"no target named {goal!r} in the roadmap (it has: {', '.join(roadmap.names)})")
+        self.result = NavigationResult(goal, False)
+        self.rng = np.random.default_rng(int(self.get_input("seed")))
+        try:
+            yield from self._navigate(goal, roadmap, targets)
+        except Failed as exc:
+            self._note(reason=str(exc))
+            raise
+        self._note(reached=True)
+        self.feedback_message = f"at {goal} via {' -> '.join(self.result.visited)}"
+
+    def _navigate(self, goal: str, roadmap: Roadmap, targets: TargetImages) -> Step[None]:
+        at = yield from self._localise(targets)
+        while at != goal:
+            path = roadmap.shortest_path(at, goal)
+            if path is None:
+                raise Failed(f"no path from {at} to {goal} in the roadmap")
+            for name, motion in zip(path.names[1:], path.motions, strict=True):
+                try:
+                    yield from self._edge(motion, name, targets)
+                except Failed:
+                    assert self.result is not None
+                    self._note(rescans=self.result.rescans + 1)
+                    at = yield from self._localise(targets)
+                    break
+                at = name
+
+    def _localise(self, targets: TargetImages) -> Step[str]:
+        """Scan, move randomly when nothing matches, home to the first target matched: its name."""
+        settings = HomingSettings.of(self)
+        limit = int(self.get_input("max_random_moves"))
+        for attempt in range(limit + 1):
+            sighting, _ = yield from scan(self, targets.views, int(self.get_input("images")), settings.min_inliers)
+            if sighting is not None:
+                try:
+                    yield from home(self, targets.get(sighting.target), settings)
+                except Failed:
+                    sighting = None
+                else:
+                    self._visit(sighting.target, first=True)
+                    return sighting.target
+            if attempt < limit:
+                yield from self._random_move()
+        raise Failed(f"no target matched after {limit} random moves")
+
+    def _random_move(self) -> Step[None]:
+        low, high = self.inputs["random_distance"]
+        turn, distance = self.rng.uniform(-math.pi, math.pi), self.rng.uniform(low, high)
+        assert self.result is not None
+        self._note(random_moves=self.result.random_moves + 1)
+        yield from self.rotate(float(turn), "random move: turning")
+        try:
+            yield from self.drive(float(distance), "random move: driving")
+        except Failed:
+            yield from self.back_off()
+
+    def _edge(self, motion: EdgeMotion, name: str, targets: TargetImages) -> Step[None]:
+        """Replay an edge (rotate, drive, rotate), then home to its target."""
+        yield from self.rotate(motion.angle1, f"edge to {name}: turning")
+        yield from self.drive(motion.distance, f"edge to {name}: driving")
+        yield from self.rotate(motion.angle2, f"edge to {name}: turning")
+        yield from home(self, targets.get(name), HomingSettings.of(self))
+        self._visit(name)
+
+    def _visit(self, name: str, first: bool = False) -> None:
+        assert self.result is not None
+        self._note(visited=(*self.result.visited, name), **({"localised_at": name} if first and
+                                                               not self.result.localised_at else {}))
+
+    def _note(self, **changes: Any) -> None:
+        assert self.result is not None
+        self.result = replace(self.result, **changes)
+        self.set_output("navigation", self.result)
+
+    def report_sections(self) -> dict[str, Any]:
+        if self.result is None:
+            return {}
+        r = self.result
+        return {"roadmap": {"navigation": {"goal": r.goal, "reached": r.reached, "localised_at": r.localised_at,
+                                           "visited": list(r.visited), "random_moves": r.random_moves,
+                                           "rescans": r.rescans, "reason": r.reason}}}
+
+    def log_rerun(self, rec: Any) -> None:
+        self.display.log_roadmap(rec, self.get_input("roadmap", None))

@@ -1,0 +1,465 @@
+"""Route following on an LT-map: home to one viewframe after another (DESIGN.md, algorithm 1).
+
+Three nodes share the work, composed in a mission (``follow_route.yaml``) with the control
+nodes rather than in one behaviour:
+
+- :class:`StartRoute` writes the :class:`RouteProgress` (``/map/route_progress``): direction
+  (forward along the route, or reverse, back to its start) and the first target viewframe.
+- :class:`FollowRoute` homes to the target viewframe: Z-infinity against its landmarks gives the
+  direction to it and the robot's rotation from it (eqs. 2-6), the circular median of the last K
+  directions is steered along (eqs. 7-8), the speed scales with the estimate's confidence
+  (eq. 9). It publishes a :class:`RouteEstimate` (``/map/route_estimate``) every new observation,
+  and fails when fewer than ``min_matches`` landmarks match the viewframe for ``lost_time``
+  (the trail is lost: a recovery, ``SearchPattern``, takes over); over a shorter gap it keeps the
+  last command, so a few frames with too few matches between two viewframes do not stop it.
+- :class:`ViewframeSwitch` moves the target on when ``delta_t`` (eq. 1) against it falls under
+  the map's threshold, or when the direction to it flips by more than 90 degrees (it was
+  passed), the second rule blocked after each switch for as long as a 180 degree turn takes
+  (tree clock). SUCCESS when the last viewframe of the route is reached.
+
+How the paper is read here (where it is vague):
+
+- **Frames.** Stored bearings are in the route frame of their viewframe (compensated for the
+  teaching robot's heading); the current bearings are in the camera body frame. Z-infinity's
+  rotation between the two gives the robot's heading in the viewframe's frame (``-yaw``), its
+  translation the direction to the viewframe in that frame. Headings are filtered in the
+  viewframe's frame, where turning on the spot does not move them, so the median of the last K
+  estimates (eqs. 7-8) is not disturbed by the robot's own turns; odometry is not used.
+- **Speed (eq. 9).** ``v = max(min_speed, speed * c)`` with ``c`` the median confidence
+  (``1 - lambda_1 / lambda_2`` of ``M``) of the last K estimates, times ``cos`` of the heading
+  error, and zero while the error exceeds ``turn_in_place``. The floor keeps the robot moving
+  near a viewframe, where the translation is short and the confidence low, until the switch
+  rule fires.
+- **Lost.** "Fewer than 50 landmarks match" is read as fewer than ``min_matches``, or than half
+  the viewframe's landmarks when it holds fewer than ``2 * min_matches`` (a map of the
+  simulator's ideal sensor in a room of 24 landmarks never reaches 50), but never fewer than
+  Z-infinity's minimum of 8. An observation with no usable estimate (no rotation, or no
+  direction yet) counts as lost too.
+- **Goal.** The switch rule fires within some radius of a viewframe (where ``delta_t`` first falls
+  under the threshold), which is right for passing through viewframes but leaves the robot short
+  of the route's end: the last viewframe is reached under ``goal_fraction`` (a quarter) of the
+  threshold, or by the flip rule when the robot passes it.
+- **Flip rule.** The filtered direction to the target is compared with the previous one for the
+  same target; a change of more than ``flip_angle`` is a flip. It counts only near the viewframe
+  (``delta_t`` under ``flip_near`` times the threshold): outdoors, with few near landmarks, the
+  direction is noisy metres away from a viewframe, and a flip there is noise, not a passed
+  viewframe.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+from scipy.spatial.transform import Rotation
+
+from behaviours.base import BearingsBehaviour
+from behaviours.landmark_tree import LTMAP_IN
+from behaviours.motion import COMMAND, ODOMETRY, STALLED
+from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.registry import register
+from drivers.interfaces import STOP, VelocityCommand
+from maps.ltmap import LandmarkTree
+from perception.geometry import wrap_angle
+from perception.heading import HeadingFilter, heading_flipped, scaled_velocity
+from perception.matching import LandmarkMatches
+from perception.observation import Observation
+from perception.similarity import delta_t
+from perception.zinf import ZinfResult, ZinfStatus, estimate_motion, estimate_translation
+
+PROGRESS_KEY = "/map/route_progress"
+ESTIMATE_KEY = "/map/route_estimate"
+ZINF_MIN_LANDMARKS = 8  # perception.zinf.estimate_motion's default minimum
+DIRECTIONS = ("forward", "reverse")
+
+
+@dataclass(frozen=True, slots=True)
+class RouteProgress:
+    """Where route following is: the viewframe homed to, and how it got there.
+
+    ``direction`` +1 follows the route from start to goal, -1 from goal back to start;
+    ``target`` is the viewframe homed to (route order; outside ``0 .. viewframes - 1`` once the
+    last one was reached); ``switched_at`` the tree time of the last switch (the start time
+    before the first).
+    """
+
+    direction: int
+    target: int
+    viewframes: int
+    switched_at: float
+    switches: int = 0
+
+    @classmethod
+    def start(cls, viewframes: int, direction: int, now: float) -> RouteProgress:
+        """Home to the route's first viewframe in ``direction`` first."""
+        return cls(direction, 0 if direction > 0 else viewframes - 1, viewframes, now)
+
+    @property
+    def finished(self) -> bool:
+        """The last viewframe of the route was reached."""
+        return not 0 <= self.target < self.viewframes
+
+    @property
+    def remaining(self) -> int:
+        """Viewframes still to reach, the target included."""
+        return max(0, self.viewframes - self.target if self.direction > 0 else self.target + 1)
+
+    def advanced(self, now: float) -> RouteProgress:
+        """The target moved on to the next viewframe in the route's direction."""
+        return replace(self, target=self.target + self.direction, switched_at=now, switches=self.switches + 1)
+
+    def retargeted(self, target: int, now: float) -> RouteProgress:
+        """Home to ``target`` from now on (the trail was found again there)."""
+        return replace(self, target=int(target), switched_at=now)
+
+
+@dataclass(frozen=True, slots=True)
+class RouteEstimate:
+    """What one observation says about the target viewframe (published by :class:`FollowRoute`).
+
+    ``heading``: eqs. 7-8, the filtered direction to the viewframe in the viewframe's frame
+    (rad, NaN before the first estimate); ``error``: the same relative to the robot's heading,
+    what steering turns by (NaN when unknown); ``delta_t``: eq. 1 against the viewframe (rad^2,
+    inf without a rotation); ``status``: Z-infinity's (``perception.zinf.ZinfStatus``) or
+    ``"lost"`` when too few landmarks matched.
+    """
+
+    viewframe: int
+    stamp: float
+    matched: int
+    status: str
+    delta_t: float
+    heading: float
+    error: float
+    confidence: float
+
+    @property
+    def usable(self) -> bool:
+        return math.isfinite(self.error)
+
+
+def lost_threshold(viewframe_size: int, min_matches: int) -> int:
+    """Fewest matches to follow a viewframe of ``viewframe_size`` landmarks (see the module doc)."""
+    small = viewframe_size < 2 * min_matches
+    return max(ZINF_MIN_LANDMARKS, math.ceil(viewframe_size / 2) if small else min_matches)
+
+
+FAR_THRESHOLDS = tuple(np.radians((1.0, 2.0, 4.0, 8.0)))  # rad: "unmoved after rotation", tightest first
+
+
+def zinf_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> tuple[ZinfResult, bool]:
+    """Z-infinity (eqs. 2-6) with the tightest far threshold that separates a rotation.
+
+    Indoors few landmarks are far enough to move less than 1 degree over the tens of centimetres
+    between viewframes (and the ideal sensor's noise alone moves a bearing by that much): with
+    no far set at 1 degree, the estimate is tried again at 2, 4 and 8 degrees, the farthest
+    landmarks there standing in for the ones at infinity. When none separates a rotation (a
+    pruned viewframe with few landmarks left), the rotation of all matched landmarks (a compass,
+    :func:`compass_motion`) keeps the robot going rather than stopping it. Returns the estimate
+    and whether it is that compass.
+    """
+    motion = estimate_motion(ref, cur, rng=rng, far_threshold=FAR_THRESHOLDS[0])
+    for threshold in FAR_THRESHOLDS[1:]:
+        if motion.status is not ZinfStatus.NO_ROTATION:
+            return motion, False
+        motion = estimate_motion(ref, cur, rng=rng, far_threshold=threshold)
+    if motion.status is ZinfStatus.NO_ROTATION:
+        return compass_motion(ref, cur, rng), True
+    return motion, False
+
+
+def compass_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> ZinfResult:
+    """A visual compass, for comparison only: the rotation fitted to ALL matched landmarks, near
+    ones included (no far/near separation), then the translation as Z-infinity finds it."""
+    ref, cur = np.asarray(ref, dtype=np.float64), np.asarray(cur, dtype=np.float64)
+    none = np.zeros(len(ref), dtype=bool)
+    if len(ref) < ZINF_MIN_LANDMARKS:
+        return ZinfResult(np.eye(3), np.zeros(3), none, none, 0.0, ZinfStatus.NOT_ENOUGH_LANDMARKS)
+    rotation = Rotation.align_vectors(cur, ref)[0].as_matrix()
+    everything = np.ones(len(ref), dtype=bool)
+    moved = estimate_translation(ref, cur @ rotation, np.ones(len(ref)), rng=rng, threshold=np.radians(1.0),
+                                 iterations=200, min_near=5)
+    if moved is None:
+        return ZinfResult(rotation, np.zeros(3), everything, everything, 0.0, ZinfStatus.NO_TRANSLATION)
+    t, inliers, confidence = moved
+    return ZinfResult(rotation, t, everything, inliers, confidence, ZinfStatus.OK)
+
+
+@register
+class StartRoute(BearingsBehaviour):
+    """Start following the LT-map's route: forward from its start, or in reverse back home.
+
+    Writes the first :class:`RouteProgress`; SUCCESS at once (FAILURE without a map).
+    """
+
+    PORTS = (
+        InputPort("direction", str, "forward", choices=DIRECTIONS,
+                  doc="forward: start to goal; reverse: goal back to the start (return home)"),
+        LTMAP_IN,
+        OutputPort("progress", RouteProgress, PROGRESS_KEY, doc="the target viewframe and the switches so far"),
+    )
+
+    def update(self) -> Status:
+        tree: LandmarkTree | None = self.get_input("ltmap", None)
+        if tree is None or tree.viewframe_count == 0:
+            self.feedback_message = "no LT-map to follow"
+            return Status.FAILURE
+        direction = 1 if self.get_input("direction") == "forward" else -1
+        self.set_output("progress", RouteProgress.start(tree.viewframe_count, direction, self.now()))
+        self.feedback_message = f"{tree.viewframe_count} viewframes, {self.get_input('direction')}"
+        return Status.SUCCESS
+
+
+FOLLOW_SPEED = InputPort("speed", float, 0.3, unit="m/s", minimum=0.01, maximum=1.2, doc="top speed (eq. 9)")
+TURN_RATE = InputPort("turn_rate", float, 45.0, unit="deg/s", minimum=1.0, maximum=300.0, doc="top turn rate")
+MIN_MATCHES = InputPort("min_matches", int, 50, minimum=ZINF_MIN_LANDMARKS,
+                        doc="fewer matched landmarks: the trail is lost (the paper: 50; see lost_threshold)")
+PROGRESS_IN = InputPort("progress", RouteProgress, Ref(PROGRESS_KEY), doc="the target viewframe")
+OBSERVATION_IN = InputPort("observation", Observation, Ref("/perception/observation"),
+                           doc="the landmarks seen now (Perceive)")
+
+
+@register
+class FollowRoute(BearingsBehaviour):
+    """Home to the target viewframe with Z-infinity: filtered heading, confidence-scaled speed.
+
+    RUNNING while it follows (it never ends by itself: :class:`ViewframeSwitch` ends the route);
+    FAILURE when the trail is lost (fewer than ``min_matches`` landmarks match, or no usable
+    estimate, for ``lost_time``; until then it keeps the last command) or the base is stalled.
+    Writes the velocity to ``command`` and a :class:`RouteEstimate` per new observation to
+    ``estimate``.
+    """
+
+    PORTS = (
+        FOLLOW_SPEED,
+        InputPort("min_speed", float, 0.05, unit="m/s", minimum=0.0, maximum=1.2,
+                  doc="speed floor while the estimate is usable, so a viewframe is always reached"),
+        TURN_RATE,
+        InputPort("heading_gain", float, 1.5, unit="1/s", minimum=0.01, doc="turn rate per rad of heading error"),
+        InputPort("turn_in_place", float, 45.0, unit="deg", minimum=1.0, maximum=180.0,
+                  doc="heading error above which the robot turns on the spot"),
+        InputPort("k", int, 5, minimum=1, maximum=100, doc="headings in the circular median (eqs. 7-8)"),
+        InputPort("min_confidence", float, 0.0, minimum=0.0, maximum=0.99,
+                  doc="confidence mapped to zero speed (eq. 9)"),
+        MIN_MATCHES,
+        InputPort("lost_time", float, 1.0, unit="s", minimum=0.0, doc="how long lost before FAILURE"),
+        InputPort("rotation", str, "zinf", choices=("zinf", "compass"),
+                  doc="zinf: rotation from far landmarks (the paper); compass: from all (for comparison)"),
+        LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, STALLED, COMMAND,
+        OutputPort("estimate", RouteEstimate, ESTIMATE_KEY, doc="the latest estimate against the target"),
+    )  # fmt: skip
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
+        super().__init__(name=name, **ports)
+        self.matches: LandmarkMatches | None = None  # the latest, for the recording
+        self.estimate: RouteEstimate | None = None
+        self._rng = np.random.default_rng(0)
+        self._reset()
+
+    def _reset(self) -> None:
+        self._filter = HeadingFilter(int(self.get_input("k")))
+        self._target: int | None = None
+        self._stamp: float | None = None
+        self._lost_since: float | None = None
+        self._command = self._coast = STOP
+
+    def initialise(self) -> None:
+        self._reset()
+
+    def update(self) -> Status:
+        tree: LandmarkTree | None = self.get_input("ltmap", None)
+        progress: RouteProgress | None = self.get_input("progress", None)
+        observation: Observation | None = self.get_input("observation", None)
+        if self.get_input("stalled", False):
+            self.feedback_message = "stalled"
+            return self._stop(Status.FAILURE)
+        if tree is None or progress is None or observation is None:
+            self.feedback_message = "waiting for the map, the route progress and an observation"
+            return self._stop(Status.RUNNING)
+        if progress.finished:
+            self.feedback_message = "the route's last viewframe was reached"
+            return self._stop(Status.SUCCESS)
+        if progress.target != self._target:
+            self._filter, self._target, self._stamp = self._filter.reset(), progress.target, None
+        if observation.stamp != self._stamp:  # a new observation: a new estimate and command
+            self._stamp = observation.stamp
+            self.estimate = self._estimate(tree, progress.target, observation)
+            self.set_output("estimate", self.estimate)
+            self._command = self._steer(self.estimate)
+        return self._lost_or_follow()
+
+    def _lost_or_follow(self) -> Status:
+        estimate = self.estimate
+        if estimate is not None and estimate.usable:
+            self._lost_since = None
+            self._coast = self._command
+            self.set_output("command", self._command)
+            self.feedback_message = (f"viewframe {estimate.viewframe}: {estimate.matched} matched, "
+                                     f"error {math.degrees(estimate.error):+.0f} deg")
+            return Status.RUNNING
+        now = self.now()
+        self._lost_since = now if self._lost_since is None else self._lost_since
+        matched = estimate.matched if estimate is not None else 0
+        self.feedback_message = f"lost: {matched} landmarks match viewframe {self._target}" + (
+            f" ({estimate.status})" if estimate is not None else "")
+        if now - self._lost_since >= float(self.get_input("lost_time")):
+            return self._stop(Status.FAILURE)
+        self.set_output("command", self._coast)  # a short gap: keep on as before (STOP before any estimate)
+        return Status.RUNNING
+
+    def _stop(self, status: Status) -> Status:
+        self.set_output("command", STOP)
+        return status
+
+    def _estimate(self, tree: LandmarkTree, target: int, observation: Observation) -> RouteEstimate:
+        matches = self.matches = tree.match(target, observation)
+        needed = lost_threshold(len(tree.viewframe(target)), int(self.get_input("min_matches")))
+        nan = float("nan")
+        if len(matches) < needed:
+            return RouteEstimate(target, observation.stamp, len(matches), "lost", math.inf, nan, nan, 0.0)
+        if self.get_input("rotation") == "compass":
+            motion, fallback = compass_motion(matches.ref, matches.cur, self._rng), False
+        else:
+            motion, fallback = zinf_motion(matches.ref, matches.cur, self._rng)  # eqs. 2-6
+        status = f"compass, {motion.status.value}" if fallback else motion.status.value
+        if not motion.rotation_ok:
+            return RouteEstimate(target, observation.stamp, len(matches), status, math.inf, nan, nan, 0.0)
+        weights = motion.inliers.astype(np.float64) if motion.inliers.any() else None
+        change = delta_t(matches.ref, matches.cur, rotation=motion.rotation, weights=weights)  # eq. 1
+        if motion.ok:
+            home = -motion.translation  # towards the viewframe, in its frame
+            self._filter = self._filter.push(math.atan2(home[1], home[0]), motion.confidence)
+        heading = self._filter.heading  # eqs. 7-8: circular median of the last K
+        if heading is None:
+            return RouteEstimate(target, observation.stamp, len(matches), status, change, nan, nan, 0.0)
+        error = wrap_angle(heading + motion.yaw)  # the robot's heading in the viewframe's frame is -yaw
+        return RouteEstimate(target, observation.stamp, len(matches), status, change, heading, error,
+                             self._filter.confidence)
+
+    def _steer(self, estimate: RouteEstimate) -> VelocityCommand:
+        if not estimate.usable:
+            return STOP
+        error, turn = estimate.error, math.radians(float(self.get_input("turn_rate")))
+        w = float(np.clip(float(self.get_input("heading_gain")) * error, -turn, turn))
+        if abs(error) > math.radians(float(self.get_input("turn_in_place"))):
+            return VelocityCommand(0.0, w)
+        speed = scaled_velocity(estimate.confidence, float(self.get_input("speed")),
+                                min_confidence=float(self.get_input("min_confidence")))  # eq. 9
+        v = max(float(self.get_input("min_speed")), speed) * math.cos(error)
+        return VelocityCommand(v, w)
+
+    def log_rerun(self, rec: Any) -> None:
+        """The estimated direction and the matched landmarks' bearings, in the robot's frame."""
+        estimate = self.estimate
+        if estimate is None or self.status != Status.RUNNING:
+            return
+        rec.log("route/target_viewframe", rec.Scalars([float(estimate.viewframe)]))
+        rec.log("route/matched", rec.Scalars([float(estimate.matched)]))
+        rec.log("route/delta_t", rec.Scalars([min(float(estimate.delta_t), 1.0)]))
+        rec.log("route/confidence", rec.Scalars([float(estimate.confidence)]))
+        if estimate.usable:
+            rec.log("route/robot_frame/direction", rec.Arrows2D(
+                vectors=[[math.cos(estimate.error), math.sin(estimate.error)]], colors=[[255, 80, 0]]))
+        if self.matches is not None and len(self.matches):
+            cur = np.asarray(self.matches.cur)
+            azimuth = np.arctan2(cur[:, 1], cur[:, 0])
+            rec.log("route/robot_frame/matched_landmarks", rec.Points2D(
+                np.column_stack((np.cos(azimuth), np.sin(azimuth))), radii=0.02, colors=[[40, 160, 255]]))
+
+
+@register
+class ViewframeSwitch(BearingsBehaviour):
+    """Move the target to the next viewframe when it is reached; SUCCESS after the last one.
+
+    Reached: ``delta_t`` (eq. 1) against the target under the map's threshold, or the direction to
+    it flipped by more than ``flip_angle`` (it was passed) once the block after the last switch is
+    over (180 degrees at ``turn_rate``: the robot may be turning to the new target). Tree clock.
+    Reports every switch (viewframe, time, rule) in the ``ltmap`` section.
+    """
+
+    PORTS = (
+        InputPort("threshold", float, 0.0, unit="rad^2", minimum=0.0,
+                  doc="eq. 1 switch threshold; 0: the one the map was taught with"),
+        InputPort("goal_fraction", float, 0.25, minimum=0.01, maximum=1.0,
+                  doc="the route's last viewframe is reached under this fraction of the threshold"),
+        InputPort("flip_angle", float, 90.0, unit="deg", minimum=1.0, maximum=180.0,
+                  doc="a change of the direction to the target larger than this: it was passed"),
+        InputPort("flip_near", float, 4.0, minimum=1.0,
+                  doc="a flip counts only while delta_t is under this many thresholds (near the viewframe)"),
+        TURN_RATE,
+        LTMAP_IN, PROGRESS_IN, ODOMETRY,
+        InputPort("estimate", RouteEstimate, Ref(ESTIMATE_KEY), doc="the latest estimate (FollowRoute)"),
+        OutputPort("advanced", RouteProgress, PROGRESS_KEY, doc="the progress after a switch"),
+    )  # fmt: skip
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
+        super().__init__(name=name, **ports)
+        self.reached: list[dict[str, Any]] = []
+        self._reached_at: list[list[float]] = []  # odometry (x, y) of each switch, for the recording
+        self._logged = 0
+        self._last: tuple[int, float] | None = None  # (target, stamp) of the last estimate used
+        self._heading: float | None = None
+
+    @property
+    def block_time(self) -> float:
+        """Seconds the flip rule waits after a switch: a 180 degree turn at ``turn_rate``."""
+        return 180.0 / float(self.get_input("turn_rate"))
+
+    def update(self) -> Status:
+        progress: RouteProgress | None = self.get_input("progress", None)
+        estimate: RouteEstimate | None = self.get_input("estimate", None)
+        tree: LandmarkTree | None = self.get_input("ltmap", None)
+        if progress is None or tree is None:
+            self.feedback_message = "waiting for the route progress and the map"
+            return Status.RUNNING
+        if progress.finished:
+            return Status.SUCCESS
+        if estimate is None or estimate.viewframe != progress.target or (progress.target, estimate.stamp) == self._last:
+            return Status.RUNNING
+        if self._last is None or self._last[0] != progress.target:
+            self._heading = None
+        self._last = (estimate.viewframe, estimate.stamp)
+        rule = self._rule(estimate, progress, float(self.get_input("threshold")) or tree.threshold)
+        if math.isfinite(estimate.heading):
+            self._heading = estimate.heading
+        self.feedback_message = f"target {progress.target}, delta_t {estimate.delta_t:.2g}"
+        if rule is None:
+            return Status.RUNNING
+        now = self.now()
+        self.reached.append({"viewframe": progress.target, "time_s": round(now, 3), "rule": rule})
+        pose = self.get_input("odometry", None)
+        if pose is not None:
+            self._reached_at.append([pose.x, pose.y])
+        advanced = progress.advanced(now)
+        self.set_output("advanced", advanced)
+        self._heading = None
+        return Status.SUCCESS if advanced.finished else Status.RUNNING
+
+    def _rule(self, estimate: RouteEstimate, progress: RouteProgress, threshold: float) -> str | None:
+        if progress.remaining == 1:  # the goal: home closer than the switching radius of the others
+            threshold *= float(self.get_input("goal_fraction"))
+        if estimate.delta_t < threshold:  # eq. 1 under the threshold: at the viewframe
+            return "delta_t"
+        blocked = self.now() - progress.switched_at < self.block_time
+        far = estimate.delta_t >= float(self.get_input("flip_near")) * threshold
+        if blocked or far or self._heading is None or not math.isfinite(estimate.heading):
+            return None
+        limit = math.radians(float(self.get_input("flip_angle")))
+        return "flip" if heading_flipped(self._heading, estimate.heading, limit=limit) else None
+
+    def report_sections(self) -> dict[str, dict[str, Any]]:
+        rules = [r["rule"] for r in self.reached]
+        return {"ltmap": {"switches": len(self.reached), "switches_by_flip": rules.count("flip"),
+                          "reached": list(self.reached)}}
+
+    def log_rerun(self, rec: Any) -> None:
+        """Where the viewframes were reached (odometry frame) and a line per switch."""
+        for entry in self.reached[self._logged:]:
+            rec.log("route/events", rec.TextLog(f"viewframe {entry['viewframe']} reached ({entry['rule']})"))
+        if len(self.reached) > self._logged and self._reached_at:
+            rec.log("odometry_frame/route/reached_viewframes", rec.Points2D(self._reached_at, radii=0.05,
+                                                                           colors=[[0, 200, 120]]))
+        self._logged = len(self.reached)

@@ -1,0 +1,152 @@
+"""The recovery of route following: drive a lying eight until the trail is found again.
+
+When too few landmarks match the target viewframe (``FollowRoute`` fails), the paper drives a
+search pattern, a "lying 8" 1.2 m across, until the trail is found. Here the eight is two
+circles of diameter ``width / 2`` side by side, the first turning left and the second right,
+driven on odometry from where the robot lost the trail (it ends where it started). Every new
+observation is matched against the target viewframe and the next ones along the route
+(``window``); the first with enough matches (the same rule as ``FollowRoute``'s) and a valid
+Z-infinity rotation becomes the target, and the node succeeds so the mission resumes following
+(in a ``RecoveryNode``). FAILURE after ``eights`` eights without the trail, or when stalled.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+
+from behaviours.base import BearingsBehaviour
+from behaviours.landmark_tree import LTMAP_IN
+from behaviours.motion import COMMAND, ODOMETRY, STALLED
+from behaviours.ports import InputPort, OutputPort
+from behaviours.registry import register
+from behaviours.route import (
+    MIN_MATCHES,
+    OBSERVATION_IN,
+    PROGRESS_IN,
+    PROGRESS_KEY,
+    RouteProgress,
+    lost_threshold,
+    zinf_motion,
+)
+from drivers.interfaces import STOP, VelocityCommand
+from maps.ltmap import LandmarkTree
+from perception.geometry import Pose2D, wrap_angle
+from perception.observation import Observation
+
+
+def lying_eight(width: float, points: int = 64) -> np.ndarray:
+    """The pattern from its start (origin, heading +x): a left circle, then a right one (N x 2)."""
+    radius = width / 4.0
+    angles = np.linspace(0.0, 2.0 * np.pi, points // 2, endpoint=False)
+    left = np.column_stack((radius * np.sin(angles), radius * (1.0 - np.cos(angles))))
+    right = np.column_stack((radius * np.sin(angles), -radius * (1.0 - np.cos(angles))))
+    return np.vstack((left, right, [[0.0, 0.0]]))
+
+
+@register
+class SearchPattern(BearingsBehaviour):
+    """Drive a lying eight ``width`` across until the trail is found; then SUCCESS.
+
+    Found: a viewframe among the target and the next ``window`` along the route matches at least
+    as many landmarks as following needs (``min_matches``, see ``route.lost_threshold``) with a
+    valid Z-infinity rotation; it becomes the target (``found`` output).
+    """
+
+    PORTS = (
+        InputPort("width", float, 1.2, unit="m", minimum=0.1, maximum=10.0, doc="the eight from end to end"),
+        InputPort("speed", float, 0.15, unit="m/s", minimum=0.01, maximum=1.2, doc="driving speed"),
+        InputPort("eights", int, 2, minimum=1, doc="eights driven before giving up"),
+        InputPort("window", int, 2, minimum=0, doc="viewframes past the target also searched for"),
+        MIN_MATCHES,
+        LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, ODOMETRY, STALLED, COMMAND,
+        OutputPort("found", type=RouteProgress, key=PROGRESS_KEY, doc="the progress with the viewframe found"),
+    )  # fmt: skip
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
+        super().__init__(name=name, **ports)
+        self.recoveries = 0
+        self.found_again = 0
+        self._rng = np.random.default_rng(0)
+        self._origin: Pose2D | None = None
+        self._logged_origin: Pose2D | None = None
+        self._last_theta, self._turned = 0.0, 0.0
+        self._stamp: float | None = None
+        self._reset()
+
+    def _reset(self) -> None:
+        self._origin, self._last_theta, self._turned, self._stamp = None, 0.0, 0.0, None
+
+    def initialise(self) -> None:
+        self._reset()
+        self.recoveries += 1
+
+    def update(self) -> Status:
+        pose: Pose2D | None = self.get_input("odometry", None)
+        if self.get_input("stalled", False):
+            self.feedback_message = "stalled"
+            return self._stop(Status.FAILURE)
+        if pose is None:
+            self.feedback_message = "waiting for odometry"
+            return self._stop(Status.RUNNING)
+        if self._found():
+            return self._stop(Status.SUCCESS)
+        if self._origin is None:
+            self._origin, self._last_theta = pose, pose.theta
+        self._turned += abs(wrap_angle(pose.theta - self._last_theta))
+        self._last_theta = pose.theta
+        lap = 2.0 * math.pi  # one circle of the eight
+        if self._turned >= 2 * lap * int(self.get_input("eights")):
+            self.feedback_message = f"the trail was not found in {self.get_input('eights')} eights"
+            return self._stop(Status.FAILURE)
+        speed = float(self.get_input("speed"))
+        turn = speed / (float(self.get_input("width")) / 4.0)
+        left = int(self._turned // lap) % 2 == 0
+        self.set_output("command", VelocityCommand(speed, turn if left else -turn))
+        self.feedback_message = f"searching: {math.degrees(self._turned):.0f} deg of the eight"
+        return Status.RUNNING
+
+    def _stop(self, status: Status) -> Status:
+        self.set_output("command", STOP)
+        return status
+
+    def _found(self) -> bool:
+        tree: LandmarkTree | None = self.get_input("ltmap", None)
+        progress: RouteProgress | None = self.get_input("progress", None)
+        observation: Observation | None = self.get_input("observation", None)
+        if tree is None or progress is None or observation is None or progress.finished:
+            return False
+        if observation.stamp == self._stamp:
+            return False
+        self._stamp = observation.stamp
+        last = tree.viewframe_count - 1
+        window = int(self.get_input("window"))
+        candidates = [progress.target + progress.direction * k for k in range(window + 1)]
+        for index in (c for c in candidates if 0 <= c <= last):
+            matches = tree.match(index, observation)
+            if len(matches) < lost_threshold(len(tree.viewframe(index)), int(self.get_input("min_matches"))):
+                continue
+            if zinf_motion(matches.ref, matches.cur, self._rng)[0].rotation_ok:
+                self.set_output("found", progress.retargeted(index, self.now()))
+                self.found_again += 1
+                self.feedback_message = f"the trail is found again at viewframe {index}"
+                return True
+        return False
+
+    def report_sections(self) -> dict[str, dict[str, Any]]:
+        return {"ltmap": {"recoveries": self.recoveries, "recoveries_found": self.found_again}}
+
+    def log_rerun(self, rec: Any) -> None:
+        """The eight being driven, in the odometry frame, while the search runs."""
+        origin = self._origin
+        if origin is None or origin is self._logged_origin:
+            return
+        self._logged_origin = origin
+        local = lying_eight(float(self.get_input("width")))
+        c, s = math.cos(origin.theta), math.sin(origin.theta)
+        world = np.column_stack((origin.x + c * local[:, 0] - s * local[:, 1],
+                                 origin.y + s * local[:, 0] + c * local[:, 1]))
+        rec.log("odometry_frame/route/search_pattern", rec.LineStrips2D([world], colors=[[255, 0, 160]]))

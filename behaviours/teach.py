@@ -1,0 +1,143 @@
+"""Teaching a route: ``LearnRoute`` records the LT-map while its child drives the robot.
+
+``LearnRoute`` is a decorator: its child is whatever drives the route (``DriveWaypoints`` on
+odometry in the simulator, ``KeyboardTeleop`` with an operator on a robot). Every tick it feeds
+each new observation, with the camera's heading from odometry, to a
+:class:`maps.ltmap.RouteLearner` (algorithm 1: a viewframe whenever ``delta_t`` passes the
+threshold; with a budget, pruned online so the route's length need not be known). When the
+child succeeds, the route is finished (the goal becomes the last viewframe), saved atomically
+to ``path`` and the decorator succeeds. When the child fails, or the run is stopped, nothing is
+saved: a file on disk is always a route that was driven to its end.
+
+The map is on ``/map/ltmap`` from the first viewframe on. The report's ``ltmap`` section holds
+the map's figures and, per viewframe, the tree time it was made (``taught``); an evaluation
+turns those times into places with the simulator's ground-truth trajectory.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import py_trees
+from py_trees.common import Status
+
+from behaviours.base import BearingsDecorator
+from behaviours.landmark_tree import LTMAP_OUT, save_map, summary_section
+from behaviours.motion import ODOMETRY
+from behaviours.ports import InputPort, Port, Ref
+from behaviours.registry import register
+from maps.ltmap import DEFAULT_MIN_LANDMARKS, DEFAULT_THRESHOLD, LearnConfig, LearnStep, RouteLearner
+from maps.store import InputError
+from perception.geometry import Pose2D
+from perception.observation import Observation
+
+
+@register
+class LearnRoute(BearingsDecorator):
+    """Record an LT-map while the child drives; save it atomically when the child succeeds.
+
+    RUNNING while the child runs; SUCCESS once the finished map is saved; FAILURE when the
+    child fails (nothing saved), when nothing was observed, or when the file cannot be written.
+    """
+
+    PORTS: ClassVar[tuple[Port, ...]] = (
+        InputPort("path", str, "", literal_only=True, doc="the LT-map file written at the end; empty: not saved"),
+        InputPort("threshold", float, DEFAULT_THRESHOLD, unit="rad^2", minimum=1e-9, literal_only=True,
+                  doc="eq. 1: a new viewframe when delta_t passes it"),
+        InputPort("budget", int, 0, unit="B", minimum=0, literal_only=True,
+                  doc="memory budget, pruned online while teaching; 0: none"),
+        InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0, literal_only=True,
+                  doc="pruning deletes viewframes left with fewer landmarks (the paper: 50)"),
+        InputPort("observation", Observation, Ref("/perception/observation"), doc="the landmarks seen now"),
+        ODOMETRY,
+        LTMAP_OUT,
+    )
+
+    def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
+        super().__init__(name=name, child=child, **ports)
+        budget = int(self.get_input("budget"))
+        self.config = LearnConfig(threshold=float(self.get_input("threshold")), budget_bytes=budget or None,
+                                  min_landmarks=int(self.get_input("min_landmarks")))
+        self.learner = RouteLearner(self.config)
+        self.taught: list[float] = []  # per viewframe, the tree time it was made
+        self.places: list[list[float]] = []  # per viewframe, the odometry (x, y) it was made at (recording)
+        self.prunes = 0
+        self.saved = False
+        self._stamp: float | None = None
+        self._logged = -1
+
+    def initialise(self) -> None:
+        self.learner = RouteLearner(self.config)
+        self.taught, self.places, self.prunes, self.saved, self._stamp = [], [], 0, False, None
+
+    def update(self) -> Status:
+        self._learn()
+        child = self.decorated.status
+        if child == Status.FAILURE:
+            self.feedback_message = "the drive failed: the route is not saved"
+            return Status.FAILURE
+        if child != Status.SUCCESS:
+            views = self.learner.tree.viewframe_count if self.learner.tree else 0
+            self.feedback_message = f"{views} viewframes"
+            return Status.RUNNING
+        return self._finish()
+
+    def _learn(self) -> None:
+        observation: Observation | None = self.get_input("observation", None)
+        pose: Pose2D | None = self.get_input("odometry", None)
+        if observation is None or pose is None or observation.stamp == self._stamp:
+            return
+        self._stamp = observation.stamp
+        self._record(self.learner.observe(observation, pose.theta), pose)  # bearings compensated by the heading
+
+    def _record(self, step: LearnStep, pose: Pose2D) -> None:
+        if step.pruned is not None and step.pruned.fits:
+            self.prunes += 1
+            kept: dict[int, int] = {}  # new viewframe -> the earliest old one it came from
+            for old, new in enumerate(step.pruned.viewframe_index[:-1].tolist()):  # the last is the new one
+                if new >= 0:
+                    kept.setdefault(new, old)
+            self.taught = [self.taught[kept[k]] for k in sorted(kept)]
+            self.places = [self.places[kept[k]] for k in sorted(kept)]
+        if step.created:
+            self.taught.append(round(self.now(), 3))
+            self.places.append([pose.x, pose.y])
+        tree = self.learner.tree
+        if tree is not None and (step.created or step.pruned is not None):
+            self.set_output("ltmap", tree)
+            self.taught, self.places = self.taught[:tree.viewframe_count], self.places[:tree.viewframe_count]
+
+    def _finish(self) -> Status:
+        if self.learner.tree is None:
+            self.feedback_message = "nothing was observed: there is no route to save"
+            return Status.FAILURE
+        pose: Pose2D = self.get_input("odometry", Pose2D())
+        self._record(self.learner.finish(), pose)
+        tree = self.learner.tree
+        path = str(self.get_input("path"))
+        if path:
+            try:
+                save_map(path, tree)
+            except (InputError, OSError) as exc:
+                self.feedback_message = f"cannot save the map: {str(exc).splitlines()[0]}"
+                return Status.FAILURE
+            self.saved = True
+        self.set_output("ltmap", tree)
+        self.feedback_message = f"{tree.viewframe_count} viewframes, {tree.memory_bytes()} bytes" + (
+            f", saved to {path}" if path else "")
+        return Status.SUCCESS
+
+    def report_sections(self) -> dict[str, dict[str, Any]]:
+        tree = self.learner.tree
+        if tree is None:
+            return {}
+        taught = [{"viewframe": i, "time_s": t} for i, t in enumerate(self.taught)]
+        return {"ltmap": {**summary_section(tree.summary()), "map_file": str(self.get_input("path")),
+                          "saved": self.saved, "online_prunes": self.prunes, "taught": taught}}
+
+    def log_rerun(self, rec: Any) -> None:
+        """The viewframes made so far, where odometry put them."""
+        if len(self.places) != self._logged and self.places:
+            self._logged = len(self.places)
+            rec.log("odometry_frame/route/viewframes", rec.Points2D(self.places, radii=0.05,
+                                                                    colors=[[255, 200, 0]]))

@@ -1,0 +1,58 @@
+"""SearchPattern in isolation: the lying eight on odometry, and the trail found again."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from py_trees.common import Status
+
+from behaviours.route import RouteProgress
+from behaviours.search import SearchPattern, lying_eight
+from behaviours.testing import BehaviourHarness
+from perception.geometry import Pose2D
+from perception.observation import Observation
+from tests.behaviours.routes import IdealBase, taught_map
+
+TREE, PLACES = taught_map()
+NOTHING = np.zeros((0, 3))
+
+
+def blind(harness: BehaviourHarness, base: IdealBase):
+    """The base moves, the camera sees nothing (the trail is lost)."""
+    def step(h: BehaviourHarness, ahead: float = 0.1) -> None:
+        if ahead:
+            base(h)
+        h.write("/perception/observation", Observation(NOTHING, h.clock.now() + ahead, "bearings",
+                                                       ids=np.zeros(0, dtype=np.int64)))
+    step(harness, 0.0)
+    return step
+
+
+def test_the_eight_is_width_across_and_ends_where_it_started():
+    points = lying_eight(1.2)
+    assert np.ptp(points[:, 1]) == pytest.approx(1.2, abs=0.01) and np.allclose(points[-1], 0.0)
+
+
+def test_search_drives_the_eight_and_fails_when_the_trail_stays_lost():
+    progress = RouteProgress(1, 3, TREE.viewframe_count, 0.0)
+    node = SearchPattern(eights=1, speed=0.2)
+    harness = BehaviourHarness(node, blackboard={"/map/ltmap": TREE, "/map/route_progress": progress})
+    base = IdealBase(harness, Pose2D(20.0, 20.0, 0.0))  # far from the route: nothing matches
+    status = harness.tick_until(between=blind(harness, base), dt=0.05, max_ticks=2000)
+    assert status == Status.FAILURE and "not found" in node.feedback_message
+    xy = np.array([(p.x, p.y) for p in base.trail])
+    assert np.ptp(xy[:, 1]) == pytest.approx(1.2, abs=0.08)  # across the eight: two circles side by side
+    assert math.dist(xy[0], xy[-1]) < 0.1  # back where it started
+    assert node.report_sections()["ltmap"] == {"recoveries": 1, "recoveries_found": 0}
+
+
+def test_search_succeeds_where_the_trail_is_found_and_retargets():
+    progress = RouteProgress(1, 3, TREE.viewframe_count, 0.0)
+    node = SearchPattern(window=2)
+    harness = BehaviourHarness(node, blackboard={"/map/ltmap": TREE, "/map/route_progress": progress})
+    IdealBase(harness, PLACES[4])  # where viewframe 4 was taught
+    assert harness.tick() == Status.SUCCESS
+    assert harness.read("/map/route_progress").target in (3, 4, 5)
+    assert harness.read("/robot/command").v == 0.0 and node.found_again == 1
