@@ -275,8 +275,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     for other in ("fixed", "baseline"):
         for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s"):
             out[f"method_vs_{other}.{key}_ratio"] = _ratio(summary["method"].get(key), summary[other].get(key))
-        out[f"method_vs_{other}.path_length_ratio"] = _ratio(summary["method"]["path_length_m"],
-                                                              summary[other]["path_length_m"])
+        out[f"method_vs_{other}.path_length_ratio"] = _ratio(summary["method"].get("path_length_m"),
+                                                              summary[other].get("path_length_m"))
     out["runs"] = sorted(runs, key=lambda r: (r["variant"], r["seed"]))
     return out
 

@@ -104,3 +104,13 @@ def test_the_command_runs_the_episodes_through_the_sweep_runner(tmp_path, capsys
         assert figures[f"{variant}.episodes"] == 1 and figures[f"{variant}.done"] == 0  # 2 s: not done
         assert 0.0 < figures[f"{variant}.coverage"] < 1.0
     assert len(figures["runs"]) == 3 and (tmp_path / "out" / "results.jsonl").exists()
+
+
+def test_episodes_that_all_fail_are_counted_not_a_crash(tmp_path, capsys):
+    code = main(["eval", "exploration", "--world", BOX, "--seeds", "1", "--workers", "1", "--timeout", "0.01",
+                 "-o", str(tmp_path / "out"), "--json"])
+    assert code == 0
+    figures = json.loads(capsys.readouterr().out)
+    for variant in ("method", "baseline", "fixed"):
+        assert figures[f"{variant}.errors"] == 1 and figures[f"{variant}.ok"] == 0
+    assert figures["method_vs_baseline.path_length_ratio"] is None
