@@ -36,7 +36,7 @@ from maps.exploration import (
     mark_traversed,
     observation_scan,
 )
-from maps.exploration_goal import Goal, GoalParams, Mode, ModeSwitch, select_goal
+from maps.exploration_goal import Goal, GoalParams, Mode, ModeSwitch, select_goal, verification_goal
 from perception.camera import PinholeCamera, StereoRig
 from perception.frame import Frame
 from perception.geometry import Pose2D
@@ -281,8 +281,10 @@ class SelectGoalPoint(BearingsBehaviour):
     blocked by what the cameras saw on the way) is spent and its border point avoided too. Before a
     selection finds no border, the avoided border points get a second chance (the map may have
     changed since: a doorway's stray obstacles cleared; the cameras looked elsewhere on arrival);
-    one reached or abandoned again is avoided for good.
-    The mode, strikes, spent points and avoided targets outlive re-entries.
+    one reached or abandoned again is avoided for good. Before a selection without a reachable border
+    counts, the obstacle cells that close a border a narrower disc reaches are looked at again
+    (:func:`maps.exploration_goal.verification_goal`: a VERIFY goal), once per place.
+    The mode, strikes, spent points, avoided targets and verified places outlive re-entries.
     """
 
     PORTS = (
@@ -311,6 +313,10 @@ class SelectGoalPoint(BearingsBehaviour):
                   doc="points seen in fewer observations do not attract"),
         InputPort("point_clearance", float, 0.3, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
                   doc="points whose floor projection is this close to an obstacle do not attract"),
+        InputPort("verify_radius", float, 0.13, unit="m", minimum=0.0, maximum=2.0, literal_only=True,
+                  doc="before done, look again at what closes a border a disc this size reaches (0: never)"),
+        InputPort("look_back", float, 1.0, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
+                  doc="...from this far before the first place the robot's disc cannot pass"),
         MAP,
         POSE,
         OutputPort("goal", Goal, "/map/exploration_goal", doc="the goal: border point, path, mode (None: none)"),
@@ -326,19 +332,23 @@ class SelectGoalPoint(BearingsBehaviour):
             closest_frontier=self.get_input("strategy") == "closest_frontier",
             min_sightings=int(self.get_input("min_sightings")),
             point_clearance=float(self.get_input("point_clearance")),
+            verify_radius=float(self.get_input("verify_radius")), look_back=float(self.get_input("look_back")),
         )  # fmt: skip
         self.switch = ModeSwitch()
         self.goal: Goal | None = None
         self.avoid: list[tuple[float, float]] = []  # reached or abandoned: avoided until a second chance
         self.forgiven: list[tuple[float, float]] = []  # had their second chance
         self.given_up: list[tuple[float, float]] = []  # reached or abandoned twice: avoided for good
+        self.verified: list[tuple[float, float]] = []  # border points whose blocking cells were looked at again
         self.selected_at = -math.inf
         self.goals: list[list[Any]] = []
         self.mode_switches: list[list[Any]] = []
         self.selections = 0
         self.reached = 0
         self.abandoned = 0
+        self.verifications = 0
         self._logged: Goal | None = None  # the goal last logged to rerun
+        self._recorded: Goal | None = None  # the goal last recorded in ``goals``
 
     def initialise(self) -> None:
         self.goal = None  # choose afresh on every entry
@@ -356,8 +366,7 @@ class SelectGoalPoint(BearingsBehaviour):
             return Status.RUNNING
         if reached and goal is not None:
             self.reached += 1
-            self.switch = self.switch.spend(goal.point)
-            self._avoid(goal.target)
+            self._spend(goal)
         before = self.switch
         self._select(m, pose, None if reached else goal)
         if self.goal is None and self.avoid:  # a second chance for the abandoned border points
@@ -365,6 +374,8 @@ class SelectGoalPoint(BearingsBehaviour):
             self.avoid = []
             self.switch = before
             self._select(m, pose, None)
+        if self.goal is None and self._verify(m, pose):
+            self.switch = before  # looking again is not a strike
         if self.switch.mode is Mode.DONE:
             self.feedback_message = "done: no border is reachable"
             return Status.SUCCESS
@@ -375,6 +386,26 @@ class SelectGoalPoint(BearingsBehaviour):
         g = self.goal
         self.feedback_message = f"{g.mode.value}: to ({g.target[0]:.2f}, {g.target[1]:.2f}), G {g.cost:.2f} m"
         return Status.RUNNING
+
+    def _spend(self, goal: Goal) -> None:
+        """A goal reached or abandoned: its point spent and its border point avoided, or, for a
+        VERIFY goal, the place it looked at verified."""
+        if goal.mode is Mode.VERIFY and goal.blocked is not None:
+            self.verified.append(goal.blocked)
+            return
+        self.switch = self.switch.spend(goal.point)
+        self._avoid(goal.target)
+
+    def _verify(self, m: ExplorationMap, pose: Pose2D) -> bool:
+        """No border is reachable: set a VERIFY goal if some border is closed only by cells worth
+        looking at again (:func:`maps.exploration_goal.verification_goal`)."""
+        skip = self.avoid + self.given_up
+        goal = verification_goal(m, (pose.x, pose.y), self.params, avoid=np.array(skip) if skip else None,
+                                 verified=np.array(self.verified) if self.verified else None)
+        if goal is None:
+            return False
+        self._set_goal(goal)
+        return True
 
     def _avoid(self, target: tuple[float, float]) -> None:
         """Avoid a border point reached or abandoned: until its second chance, or for good after it."""
@@ -390,19 +421,26 @@ class SelectGoalPoint(BearingsBehaviour):
         now = round(self.now(), 2)
         if self.switch.mode is not before:
             self.mode_switches.append([now, before.value, self.switch.mode.value])
-        if goal is not None and (self.goal is None or goal.point != self.goal.point
-                                 or math.dist(goal.target, self.goal.target) > 0.25):
-            self.goals.append([now, goal.mode.value, round(goal.target[0], 3), round(goal.target[1], 3),
-                               goal.point, round(goal.distance, 3), round(goal.cost, 3),
+        self._set_goal(goal)
+
+    def _set_goal(self, goal: Goal | None) -> None:
+        """Make ``goal`` the goal (on the blackboard) and record it when it is a new one."""
+        last = self._recorded
+        if goal is not None and (last is None or goal.mode is not last.mode or goal.point != last.point
+                                 or math.dist(goal.target, last.target) > 0.25):
+            self._recorded = goal
+            self.goals.append([round(self.now(), 2), goal.mode.value, round(goal.target[0], 3),
+                               round(goal.target[1], 3), goal.point, round(goal.distance, 3), round(goal.cost, 3),
                                None if math.isnan(goal.power) else round(goal.power, 3)])
+            if goal.mode is Mode.VERIFY:
+                self.verifications += 1
         self.goal = goal
         self.set_output("goal", goal)
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and self.goal is not None:  # halted: the goal could not be followed
             self.abandoned += 1
-            self.switch = self.switch.spend(self.goal.point)
-            self._avoid(self.goal.target)
+            self._spend(self.goal)
             self.goal = None
             self.set_output("goal", None)
 
@@ -415,6 +453,7 @@ class SelectGoalPoint(BearingsBehaviour):
             "selections": self.selections,
             "goals_reached": self.reached,
             "goals_abandoned": self.abandoned,
+            "verifications": self.verifications,
             "goal_count": len(self.goals),
             "goals": self.goals,
             "goal_columns": "t, mode, x, y, point, d, G, A_P",

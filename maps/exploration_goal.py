@@ -63,7 +63,7 @@ from enum import StrEnum
 import numpy as np
 from scipy.spatial import cKDTree
 
-from maps.exploration import Cell, ExplorationMap, TravelCost, borders, clearance, travel_cost
+from maps.exploration import Cell, ExplorationMap, TravelCost, borders, clearance, travel_cost, traversable
 
 
 class Mode(StrEnum):
@@ -72,6 +72,7 @@ class Mode(StrEnum):
     ATTRACTION = "attraction"  # going for the point with the highest attractive power (eq. 1)
     FRONTIER = "frontier"  # no point has d > K: the closest reachable border point
     DONE = "done"  # no border is reachable
+    VERIFY = "verify"  # a goal only: look again at the obstacle cells that close a border (see verification_goal)
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,14 +91,16 @@ class GoalParams:
     closest_frontier: bool = False  # always the closest reachable border (the baseline), never eq. 1
     min_sightings: int = 1  # points seen in fewer observations do not attract (stray stereo matches)
     point_clearance: float = 0.0  # m: points whose floor projection is this close to an obstacle cell do not attract
+    verify_radius: float = 0.0  # m: > 0: before DONE, look again at what closes a border a disc this size reaches
+    look_back: float = 1.0  # m: ...from this far before the first cell the robot's own disc cannot pass
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.eta <= 0.5:
             raise ValueError(f"eta must be in [0, 0.5] (eq. 1), got {self.eta}")
         if min(self.k, self.robot_radius, self.min_frontier, self.margin, self.penalty, self.hysteresis,
-               self.avoid_radius, self.point_clearance) < 0.0:
-            raise ValueError("k, robot_radius, min_frontier, margin, penalty, hysteresis, avoid_radius and "
-                             "point_clearance must not be negative")
+               self.avoid_radius, self.point_clearance, self.verify_radius, self.look_back) < 0.0:
+            raise ValueError("k, robot_radius, min_frontier, margin, penalty, hysteresis, avoid_radius, "
+                             "point_clearance, verify_radius and look_back must not be negative")
         if self.patience < 1:
             raise ValueError(f"patience must be at least 1, got {self.patience}")
 
@@ -135,6 +138,7 @@ class Goal:
 
     ``point`` is the index of P_p in the map's points (None in frontier mode); ``distance`` is
     d(P_p, P_b) (0 in frontier mode), ``cost`` G(v_S, P_b) and ``power`` A_P (NaN in frontier mode).
+    A VERIFY goal's ``target`` is where to look from and ``blocked`` the border point it is for.
     """
 
     mode: Mode
@@ -144,6 +148,7 @@ class Goal:
     cost: float
     power: float
     path: np.ndarray
+    blocked: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -257,3 +262,52 @@ def _closest_border(found: Candidates, current: Goal | None, hysteresis: float, 
     if gap[near] <= 1.5 * resolution and found.border_cost[near] <= found.border_cost[best] + hysteresis:
         return near
     return best
+
+
+def verification_goal(
+    m: ExplorationMap,
+    robot: tuple[float, float],
+    params: GoalParams,
+    *,
+    avoid: np.ndarray | None = None,
+    verified: np.ndarray | None = None,
+) -> Goal | None:
+    """Where to look from, before giving up, at the obstacle cells that close a border.
+
+    For when no border is reachable: among the border points that a disc of ``verify_radius``
+    reaches (none within ``avoid_radius`` of ``avoid``), the closest whose narrow path is closed
+    for the robot's own disc at a place (``blocked``: the first cell of the path it cannot pass)
+    not within ``look_back`` of one already ``verified`` (one look covers that much). The goal is the cell of that path
+    ``look_back`` metres before the place (or the last passable one, nearer). Driving there faces the
+    cells that closed the way; if they were stereo speckle or smear they clear (the evidence is
+    log-odds) and the border becomes reachable; if they stay, the caller adds ``blocked`` to
+    ``verified``. None: nothing to verify.
+    A choice of ours (the paper ends at the first selection without a reachable border): in
+    simulated runs of a flat with doors, a few cells of smear just inside a doorway, never seen
+    again, ended exploration with a room unvisited.
+    """
+    if params.verify_radius <= 0.0 or params.verify_radius >= params.robot_radius:
+        return None
+    narrow = candidates(m, robot, replace(params, robot_radius=params.verify_radius), avoid)
+    passable = traversable(m, params.robot_radius)
+    done = np.zeros((0, 2)) if verified is None else np.asarray(verified, dtype=np.float64).reshape(-1, 2)
+    order = np.argsort(narrow.border_cost, kind="stable")[:MAX_VERIFY_TRIES]
+    for b in order:
+        path = narrow.travel.path_to((float(narrow.border[b, 0]), float(narrow.border[b, 1])))
+        rows, cols = m.frame.cell_of(path)
+        ok = passable[rows, cols]
+        if ok.all() or not ok[0]:  # nothing closes it, or the robot stands where its disc does not fit
+            continue
+        first = int(np.argmin(ok))  # the first cell the robot's disc cannot pass
+        blocked = (float(path[first, 0]), float(path[first, 1]))
+        if len(done) and np.hypot(*(done - np.asarray(blocked)).T).min() <= params.look_back:
+            continue
+        arc = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))))
+        before = np.flatnonzero(arc[:first] <= arc[first] - params.look_back)
+        stop = int(before[-1]) if len(before) else first - 1
+        target = (float(path[stop, 0]), float(path[stop, 1]))
+        return Goal(Mode.VERIFY, target, None, 0.0, float(arc[stop]), math.nan, path[: stop + 1], blocked)
+    return None
+
+
+MAX_VERIFY_TRIES = 200  # border points tried per verification (closest first)

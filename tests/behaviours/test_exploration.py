@@ -210,3 +210,38 @@ def test_waits_for_the_map():
     harness = BehaviourHarness(select(), blackboard={POSE: Pose2D()})
     assert harness.tick() == Status.RUNNING and harness.read(GOAL) is None
 
+
+
+def clumped_gap(clump: bool = True) -> ExplorationMap:
+    """The walled room with obstacle cells in the middle of its gap (y 0.9-1.1): two 0.3 m gaps,
+    too narrow for a 0.2 m robot, wide enough for a 0.13 m disc."""
+    m = explored_room([])
+    cells = m.cells.copy()
+    if clump:
+        cells[19:21, 40] = Cell.OBSTACLE
+    return ExplorationMap.from_cells(m.frame, cells)
+
+
+def test_a_border_closed_by_a_clump_is_looked_at_again_before_done():
+    harness = BehaviourHarness(select(patience=2), blackboard={MAP: clumped_gap(), POSE: Pose2D(0.5, 1.0)})
+    assert harness.tick() == Status.RUNNING  # not a strike: first look at the clump again
+    goal = harness.read(GOAL)
+    assert goal.mode is Mode.VERIFY and goal.blocked is not None and goal.blocked[0] > 2.5
+    assert goal.path[-1] == pytest.approx(goal.target) and goal.target[0] < goal.blocked[0] - 0.9
+    harness.write(POSE, Pose2D(*goal.target))  # arrived; the clump is still there
+    assert harness.tick() == Status.FAILURE  # the place is verified; nothing else to look at: a strike
+    assert harness.behaviour.verified == [goal.blocked] and harness.behaviour.switch.strikes == 1
+    assert harness.tick() == Status.SUCCESS
+    assert harness.behaviour.report_sections()["exploration"]["verifications"] == 1
+
+
+def test_a_clump_that_clears_when_looked_at_opens_the_border():
+    harness = BehaviourHarness(select(reselect=1.0), blackboard={MAP: clumped_gap(), POSE: Pose2D(0.5, 1.0)})
+    harness.tick()
+    assert harness.read(GOAL).mode is Mode.VERIFY
+    harness.write(MAP, clumped_gap(clump=False))  # the floor there was seen free on the way
+    harness.clock.advance(1.1)
+    assert harness.tick() == Status.RUNNING
+    goal = harness.read(GOAL)
+    assert goal.mode is Mode.FRONTIER and goal.target[0] == pytest.approx(3.05)
+    assert harness.behaviour.verified == []  # the look was not needed to the end
