@@ -95,6 +95,9 @@ def log_map(rec: Any, rr: Any, m: ExplorationMap, border: np.ndarray) -> None:
         rec.log("exploration_3d/interest_edges", rr.LineStrips3D(strips, colors=colours, radii=0.01))
 
 
+HEAD_PORTS = (PAN_RATE, PAN_LIMITS, TILT_LIMITS, VERTICAL_FOV, HORIZONTAL_FOV, PTU_POSITION, CAMERA_POSITION)  # the pan-tilt head's ports
+
+
 @register
 class WatchInterestEdges(BearingsBehaviour):
     """Watch interest edges with the pan-tilt cameras while the robot drives (eq. 2-5).
@@ -125,13 +128,7 @@ class WatchInterestEdges(BearingsBehaviour):
                   doc="tilt targets are rounded to this (the head holds still through small changes)"),
         InputPort("max_speed", float, 1.2, unit="m/s", minimum=0.01, maximum=5.0, literal_only=True,
                   doc="the speed limit written when eq. 4 sets none"),
-        PAN_RATE,
-        PAN_LIMITS,
-        TILT_LIMITS,
-        VERTICAL_FOV,
-        HORIZONTAL_FOV,
-        PTU_POSITION,
-        CAMERA_POSITION,
+        *HEAD_PORTS,
         InputPort("turn_rate", float, 0.0, unit="rad/s", doc="the robot's commanded turn rate (eq. 4)"),
         InputPort("near_floor", float, 0.8, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
                   doc="unseen floor nearer than this to the pan axis is looked at from this far"),
@@ -246,13 +243,7 @@ class LookAround(BearingsBehaviour):
                   doc="hold each pose this long once there"),
         InputPort("tolerance", float, 1.0, unit="deg", minimum=0.01, maximum=10.0, literal_only=True,
                   doc="the head is at a pose within this"),
-        PAN_RATE,
-        PAN_LIMITS,
-        TILT_LIMITS,
-        VERTICAL_FOV,
-        HORIZONTAL_FOV,
-        PTU_POSITION,
-        CAMERA_POSITION,
+        *HEAD_PORTS,
         InputPort("ptu", PanTiltState, Ref("/ptu/state"), doc="where the head is"),
         PTU_COMMAND,
     )
