@@ -275,7 +275,10 @@ def verification_goal(
     """Where to look from, before giving up, at the obstacle cells that close a border.
 
     For when no border is reachable: among the border points that a disc of ``verify_radius``
-    reaches (none within ``avoid_radius`` of ``avoid``), the closest whose narrow path is closed
+    reaches (none within ``avoid_radius`` of ``avoid``) and that are the nearest such border point
+    of some detected point lying more than ``k`` beyond (open space seen through the gap, as for
+    eq. 1; a gap between furniture and a wall with nothing beyond is not worth the trip), the
+    closest whose narrow path is closed
     for the robot's own disc at a place (``blocked``: the first cell of the path it cannot pass)
     not within ``look_back`` of one already ``verified`` (one look covers that much). The goal is the cell of that path
     ``look_back`` metres before the place (or the last passable one, nearer). Driving there faces the
@@ -291,7 +294,9 @@ def verification_goal(
     narrow = candidates(m, robot, replace(params, robot_radius=params.verify_radius), avoid)
     passable = traversable(m, params.robot_radius)
     done = np.zeros((0, 2)) if verified is None else np.asarray(verified, dtype=np.float64).reshape(-1, 2)
-    order = np.argsort(narrow.border_cost, kind="stable")[:MAX_VERIFY_TRIES]
+    promising = np.zeros(len(narrow.border), dtype=bool)  # a point lies more than K beyond: open space, not a nook
+    promising[narrow.nearest[(narrow.distance > params.k) & (narrow.nearest >= 0)]] = True
+    order = np.flatnonzero(promising)[np.argsort(narrow.border_cost[promising], kind="stable")][:MAX_VERIFY_TRIES]
     for b in order:
         path = narrow.travel.path_to((float(narrow.border[b, 0]), float(narrow.border[b, 1])))
         rows, cols = m.frame.cell_of(path)

@@ -215,11 +215,11 @@ def test_waits_for_the_map():
 def clumped_gap(clump: bool = True) -> ExplorationMap:
     """The walled room with obstacle cells in the middle of its gap (y 0.9-1.1): two 0.3 m gaps,
     too narrow for a 0.2 m robot, wide enough for a 0.13 m disc."""
-    m = explored_room([])
+    m = explored_room([FAR_EAST])
     cells = m.cells.copy()
     if clump:
         cells[19:21, 40] = Cell.OBSTACLE
-    return ExplorationMap.from_cells(m.frame, cells)
+    return ExplorationMap.from_cells(m.frame, cells, points=m.points)
 
 
 def test_a_border_closed_by_a_clump_is_looked_at_again_before_done():
@@ -243,5 +243,5 @@ def test_a_clump_that_clears_when_looked_at_opens_the_border():
     harness.clock.advance(1.1)
     assert harness.tick() == Status.RUNNING
     goal = harness.read(GOAL)
-    assert goal.mode is Mode.FRONTIER and goal.target[0] == pytest.approx(3.05)
+    assert goal.mode is Mode.ATTRACTION and goal.target[0] == pytest.approx(3.05)
     assert harness.behaviour.verified == []  # the look was not needed to the end

@@ -182,10 +182,11 @@ def test_points_next_to_obstacles_do_not_attract_with_a_point_clearance():
     assert found.distance[0] == 0.0 and found.distance[1] > 1.0
 
 
-def doorway(speckle: bool) -> ExplorationMap:
+def doorway(speckle: bool, points: bool = True) -> ExplorationMap:
     """A walled room [0, 3] x [0, 2] (0.1 m cells) with a 0.8 m door in its east wall at y 0.6-1.4
     and a walled passage beyond, explored for 0.4 m (x 3.1-3.5), unknown after; ``speckle``: a 2 x 2
-    obstacle clump in the passage at (3.2-3.4, 0.9-1.1), which leaves gaps of 0.3 m either side."""
+    obstacle clump in the passage at (3.2-3.4, 0.9-1.1), which leaves gaps of 0.3 m either side;
+    ``points``: a point seen 1.15 m beyond the border (something to explore there)."""
     cells = np.zeros((23, 51), dtype=np.uint8)  # frame x0 = y0 = -0.1: cell (r, c) centre (c/10 - 0.05, r/10 - 0.05)
     cells[1:21, 1:31] = Cell.FREE  # the room
     cells[[0, 21], 0:32] = Cell.OBSTACLE
@@ -195,7 +196,9 @@ def doorway(speckle: bool) -> ExplorationMap:
     cells[[6, 15], 32:36] = Cell.OBSTACLE  # the passage's walls
     if speckle:
         cells[10:12, 33:35] = Cell.OBSTACLE
-    return ExplorationMap.from_cells(GridFrame(-0.1, -0.1, 0.1, 23, 51), cells)
+    beyond = np.array([[4.6, 1.05, 0.5]])  # a point seen through the door, 1.15 m beyond the border
+    return ExplorationMap.from_cells(GridFrame(-0.1, -0.1, 0.1, 23, 51), cells,
+                                     points=beyond if points else np.zeros((0, 3)))
 
 
 VERIFY = GoalParams(robot_radius=0.26, min_frontier=0.1, verify_radius=0.1, look_back=1.0)
@@ -220,10 +223,11 @@ def test_nothing_to_verify_without_the_clump_or_once_verified_or_when_off():
     robot = (0.55, 1.05)
     clear = doorway(speckle=False)
     _, goal = select_goal(ModeSwitch(), clear, robot, VERIFY)
-    assert goal is not None and goal.mode is Mode.FRONTIER  # the door itself is passable
+    assert goal is not None and goal.mode is Mode.ATTRACTION  # the door itself is passable
     m = doorway(speckle=True)
     blocked = verification_goal(m, robot, VERIFY)
     assert blocked is not None and blocked.blocked is not None
     assert verification_goal(m, robot, VERIFY, verified=np.array([blocked.blocked])) is None
     assert verification_goal(m, robot, VERIFY, avoid=np.array([[3.45, y] for y in (0.75, 1.05, 1.35)])) is None
     assert verification_goal(m, robot, GoalParams(robot_radius=0.26, min_frontier=0.1)) is None
+    assert verification_goal(doorway(speckle=True, points=False), robot, VERIFY) is None  # nothing seen beyond
