@@ -294,8 +294,7 @@ def verification_goal(
     narrow = candidates(m, robot, replace(params, robot_radius=params.verify_radius), avoid)
     passable = traversable(m, params.robot_radius)
     done = np.zeros((0, 2)) if verified is None else np.asarray(verified, dtype=np.float64).reshape(-1, 2)
-    promising = np.zeros(len(narrow.border), dtype=bool)  # a point lies more than K beyond: open space, not a nook
-    promising[narrow.nearest[(narrow.distance > params.k) & (narrow.nearest >= 0)]] = True
+    promising = _promising(m, narrow.border, params)
     order = np.flatnonzero(promising)[np.argsort(narrow.border_cost[promising], kind="stable")][:MAX_VERIFY_TRIES]
     for b in order:
         path = narrow.travel.path_to((float(narrow.border[b, 0]), float(narrow.border[b, 1])))
@@ -313,6 +312,21 @@ def verification_goal(
         target = (float(path[stop, 0]), float(path[stop, 1]))
         return Goal(Mode.VERIFY, target, None, 0.0, float(arc[stop]), math.nan, path[: stop + 1], blocked)
     return None
+
+
+def _promising(m: ExplorationMap, border: np.ndarray, params: GoalParams) -> np.ndarray:
+    """Border points (bool, B) that are the nearest of some detected point in unknown space more
+    than ``k`` beyond them and seen ``min_sightings`` times (unlike eq. 1's candidates, points near
+    obstacle cells count: the walls of a room seen through a door are what says a room is there)."""
+    promising = np.zeros(len(border), dtype=bool)
+    if len(border) == 0 or len(m.points) == 0:
+        return promising
+    seen = (m.cell_state(m.points[:, :2]) == Cell.UNKNOWN) & (m.sightings >= params.min_sightings)
+    if not seen.any():
+        return promising
+    distance, nearest = cKDTree(border).query(m.points[seen, :2])
+    promising[nearest[distance > params.k]] = True
+    return promising
 
 
 MAX_VERIFY_TRIES = 200  # border points tried per verification (closest first)
