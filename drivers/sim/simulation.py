@@ -220,7 +220,8 @@ class Simulation:
         """The ``ground_truth`` section of a run report (DESIGN.md, contracts).
 
         Always: ``trajectory_length_m``, ``final_pose``, ``odometry_drift_m``, ``collisions``,
-        ``stalled_time_s``, ``trajectory`` (decimated) and the true ``landmarks``; with ``goal``
+        ``stalled_time_s``, ``trajectory`` (decimated), ``stops`` (every stretch the robot stood
+        still, exactly: see :func:`_stops`) and the true ``landmarks``; with ``goal``
         (x, y): ``goal_error_m``; with a ``reference_path`` of (x, y) points: ``path_error_m``
         (mean distance of the trajectory to it) and ``path_error_max_m``. ``goal`` and
         ``reference_path`` are world coordinates, or with ``frame="start"`` coordinates relative
@@ -243,6 +244,7 @@ class Simulation:
             "collisions": int(self.collisions),
             "stalled_time_s": float(self._stalled_time),
             "trajectory": _decimate(true, max_points=2000),
+            "stops": _stops(true),
             "landmarks": [[int(lm.id), lm.x, lm.y, lm.z] for lm in self.world.landmarks],
         }
         if goal is not None:
@@ -322,6 +324,24 @@ def _world_to_start(start: Sequence[float], xy: np.ndarray) -> np.ndarray:
     c, s = math.cos(th0), math.sin(th0)
     rel = xy - (x0, y0)
     return np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])
+
+
+def _stops(rows: np.ndarray, *, tolerance: float = 1e-6) -> list[list[float]]:
+    """Every stretch of (t, x, y, theta) rows over which the robot stood still (no step moved it
+    more than ``tolerance`` m or rad: a still robot does not move at all in the simulator):
+    ``[t_first, t_last, x, y, theta]``, rounded as the trajectory.
+
+    The decimated trajectory cannot say where the robot was at a given time to better than its
+    spacing (up to half a second in a long run, with a turn starting right after a still image);
+    an evaluation that needs the true pose when an image was taken finds the stop holding that
+    time here instead (images are taken standing still)."""
+    if len(rows) < 2:
+        return []
+    still = np.all(np.abs(np.diff(rows[:, 1:4], axis=0)) <= tolerance, axis=1).astype(np.int8)
+    edges = np.diff(np.concatenate([[0], still, [0]]))
+    first, end = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # step runs [first, end)
+    out = np.column_stack([rows[first, 0], rows[end, 0], rows[first, 1:4]])
+    return np.round(out, 4).tolist()
 
 
 def _decimate(rows: np.ndarray, *, max_points: int) -> list[list[float]]:

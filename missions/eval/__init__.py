@@ -26,6 +26,7 @@ from typing import TextIO
 AREAS = {
     "exploration": "missions.eval.exploration",
     "ltmap": "missions.eval.ltmap",
+    "roadmap": "missions.eval.roadmap",
 }
 
 

@@ -73,7 +73,10 @@ OPTIONS = {
                      "viewframe of a map with small viewframes)",
     "goal_tolerance": "m: the goal is reached when the repeat succeeds and ends this close to the route's start "
                       "(default: the robot's diameter or the taught viewframes' spacing, whichever is larger)",
+    "rotation": "how the repeat estimates its rotation: zinf (Z-infinity, the paper; default) or compass (the "
+                "median bearing change of every landmark: the comparison for worlds with near landmarks)",
 }
+ROTATIONS = ("zinf", "compass")
 TEACH, FOLLOW = "teach_route", "follow_route"
 CAMERA_KINDS = ("panorama", "bearings")
 SMALL_VIEWFRAME = 2 * DEFAULT_MIN_LANDMARKS  # landmarks: below this, min_landmarks is half the median viewframe
@@ -89,6 +92,7 @@ class Settings:
     route: Route
     min_landmarks: int | None  # None: from the map (module docstring)
     goal_tolerance: float | None  # m; None: per seed from the robot and the map (module docstring)
+    rotation: str = "zinf"  # FollowRoute's rotation estimate (ROTATIONS)
 
 
 def check_world(world: str) -> World:
@@ -119,7 +123,10 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
         tolerance = _number(extra["goal_tolerance"], "goal_tolerance", float)
         if not (math.isfinite(tolerance) and tolerance > 0):
             raise ValueError(f"goal_tolerance must be a positive number of metres, got {extra['goal_tolerance']!r}")
-    return Settings(camera, route, min_landmarks, tolerance)
+    rotation = extra.get("rotation", "zinf")
+    if rotation not in ROTATIONS:
+        raise ValueError(f"rotation must be one of {', '.join(ROTATIONS)}, got {rotation!r}")
+    return Settings(camera, route, min_landmarks, tolerance, rotation)
 
 
 def _number(text: str, name: str, kind: type[int] | type[float]) -> Any:
@@ -180,7 +187,7 @@ def teach_episode(world: str, seed: int, settings: Settings, folder: Path, max_t
 
 
 def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_landmarks: int,
-                   max_time_s: float | None) -> Episode:
+                   max_time_s: float | None, rotation: str = "zinf") -> Episode:
     """The repeat of ``teach``'s map cut by ``level.cut`` levels, from the teach's true end pose."""
     end = report["ground_truth"]["final_pose"]
     start = f"{end['x']:.4f},{end['y']:.4f},{math.degrees(end['theta']):.3f}deg"
@@ -188,6 +195,8 @@ def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_
                               "min_landmarks": min_landmarks}
     if level.cut:
         inputs["budget"] = level.bytes
+    if rotation != "zinf":  # only when not the default: the ids of earlier results stay what they were
+        inputs["rotation"] = rotation
     if max_time_s is None:
         a, b = REPEAT_TIME
         max_time_s = float(math.ceil((a + b * float(report.get("sim_time_s", 0.0))) / 10.0) * 10.0)
@@ -345,7 +354,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
                            "goal_tolerance_m": tolerance[seed],
                            "path_length_m": report["ground_truth"]["trajectory_length_m"],
                            "sim_time_s": report.get("sim_time_s")})
-        plan += [(follow_episode(teach, report, level, minimum, options.max_time_s), report, level)
+        plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation), report, level)
                  for level in levels(tree, minimum)]
     if plan:  # every repeat at once: the pool runs them in parallel
         run_sweep([episode for episode, _, _ in plan], executor=options.executor, results_dir=folder,
@@ -367,6 +376,7 @@ def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dic
     out: dict[str, Any] = {
         "world": world.name,
         "camera": settings.camera,
+        "rotation": settings.rotation,
         "seeds": seeds,
         "route_source": settings.route.source,
         "route_length_m": settings.route.length_m,
@@ -427,7 +437,7 @@ def format_table(figures: Mapping[str, Any]) -> str:
     route = f"{figures['route_source']} of {figures['route_length_m']:.1f} m"
     lines = [
         f"LT-map teach and repeat in {figures['world']}: {figures['seeds']} seed(s), camera {figures['camera']}, "
-        f"route: {route}, taught {figures['taught']}/{figures['seeds']}",
+        f"rotation {figures.get('rotation', 'zinf')}, route: {route}, taught {figures['taught']}/{figures['seeds']}",
         f"goal reached: {figures['criterion']}; min_landmarks {figures['min_landmarks']}; path error of the repeats "
         "that reached the goal (of all repeats)",
         f"{'height':>6} {'cut':>3} {'viewframes':>10} {'landmarks':>9} {'memory %':>8} {'vf err m':>8} "

@@ -8,12 +8,12 @@
    (reference frame, from the report) with its true pose expressed in the TRUE reference frame
    (the simulator's true robot pose when the reference image was taken, recorded here every
    tick: evaluation only, the behaviours never see it);
-3. runs ``goto_target`` from ``--starts`` random start poses (uniform in the world's bounds,
-   at least 0.45 m from any surface, any heading; a new world file per start), each to a goal
+3. runs ``goto_target`` from ``--starts`` random start poses (``random_starts``: uniform in the
+   world's bounds, at least 0.45 m from any surface, any heading; a new world file per start), each to a goal
    drawn among the targets, and compares the final true pose with the goal's true pose.
 
 Prints one JSON object of figures (and writes it to OUT/figures.json). Not a test: minutes per
-run. ``bearings eval roadmap`` will run the same missions through the sweep runner.
+run. ``bearings eval roadmap`` runs the same missions through the sweep runner (any world, many seeds).
 """
 
 from __future__ import annotations
@@ -29,10 +29,17 @@ import numpy as np
 
 from drivers.sim.simulation import Simulation
 from drivers.sim.world import load_world
+from missions.eval.roadmap_world import (
+    named_poses,
+    pose_error,
+    random_starts,
+    target_errors,
+    world_with,
+    write_target_images,
+)
 from missions.loader import load_mission
 from missions.runner import Runner, RunOptions
 from perception.geometry import Pose2D
-from tests.missions.roadmap_world import named_poses, pose_error, target_errors, world_with, write_target_images
 
 POSITION_OK, HEADING_OK = 0.15, 5.0  # the issue's thresholds (m, deg)
 
@@ -81,22 +88,12 @@ def learn(world: str, targets: list[str], seed: int, out: Path) -> dict[str, Any
     return figures
 
 
-def random_start(world: str, rng: np.random.Generator) -> Pose2D:
-    sim = Simulation(load_world(world), seed=0)
-    xs = [p[0] for w in sim.world.walls for p in w.points]
-    ys = [p[1] for w in sim.world.walls for p in w.points]
-    while True:
-        x, y = rng.uniform(min(xs), max(xs)), rng.uniform(min(ys), max(ys))
-        if sim.scene.clearance(x, y) > 0.45:
-            return Pose2D(x, y, rng.uniform(-math.pi, math.pi))
-
-
 def navigate(world: str, targets: list[str], seed: int, starts: int, out: Path) -> dict[str, Any]:
     rng = np.random.default_rng(seed)
     truth = named_poses(world)
     runs = []
-    for k in range(starts):
-        start, goal = random_start(world, rng), str(rng.choice(targets))
+    for k, start in enumerate(random_starts(load_world(world), starts, seed)):
+        goal = str(rng.choice(targets))
         path = world_with(world, out / f"start{k}.yaml", start=start)
         started = time.monotonic()
         report, _, final = run_mission("goto_target", path, seed + k, {"roadmap": str(out / "roadmap.map"),

@@ -12,8 +12,17 @@ import pytest
 
 from drivers.sim.world import load_world
 from missions.cli import main
-from missions.eval.ltmap import Level, check_options, format_table, goal_tolerance, repeat_figures, viewframe_errors
+from missions.eval.ltmap import (
+    Level,
+    check_options,
+    follow_episode,
+    format_table,
+    goal_tolerance,
+    repeat_figures,
+    viewframe_errors,
+)
 from missions.eval.ltmap_route import MARGINS, MIN_END, Floor, default_route, parse_route, to_world
+from missions.sweep import Episode
 
 # A 6 x 4 m room with a box and a pillar, landmarks on the walls and the furniture, the robot
 # starting in a corner facing the room's far end.
@@ -73,10 +82,23 @@ def test_options_are_checked_against_the_world(world_file):
                            ({"route": "9,0"}, "waypoint 0 .* not on the floor"),
                            ({"route": "1.521,0.085,3.024,-0.462"}, "leg to waypoint 1 passes"),  # across the pillar
                            ({"min_landmarks": "-1"}, ">= 0"),
-                           ({"goal_tolerance": "nan"}, "positive")]:
+                           ({"goal_tolerance": "nan"}, "positive"),
+                           ({"rotation": "gyro"}, "zinf, compass")]:
         with pytest.raises(ValueError, match=message):
             check_options(path, extra)
     assert parse_route("1, 2,3,4") == [1.0, 2.0, 3.0, 4.0]
+    assert check_options(path, {"camera": "landmarks"}).rotation == "zinf"
+    assert check_options(path, {"camera": "landmarks", "rotation": "compass"}).rotation == "compass"
+
+
+def test_the_compass_repeat_carries_its_rotation_and_the_default_keeps_the_ids():
+    teach = Episode("teach_route", "lab", 0, {"map": "m.ltmap", "camera": "panorama"})
+    report = {"ground_truth": {"final_pose": {"x": 1.0, "y": 2.0, "theta": 0.5}}, "sim_time_s": 10.0}
+    level = Level(cut=0, height=4, viewframes=10, landmarks=1000, bytes=50_000, fraction=1.0)
+    default = follow_episode(teach, report, level, 50, None)
+    compass = follow_episode(teach, report, level, 50, None, "compass")
+    assert "rotation" not in default.inputs and compass.inputs["rotation"] == "compass"
+    assert default.id != compass.id
 
 
 def _report(rows, **sections):

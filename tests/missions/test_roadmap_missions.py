@@ -13,8 +13,8 @@ import pytest
 
 from maps.roadmap import EdgeMotion, Roadmap
 from missions.cli import main
+from missions.eval.roadmap_world import TrueTrajectory, named_poses, pose_error, world_with, write_target_images
 from perception.geometry import Pose2D
-from tests.missions.roadmap_world import named_poses, pose_error, world_with, write_target_images
 
 SMALL_ROOM = """
     # a 5 x 4 m room with a box and a pillar; cameras at half resolution, so a whole learning run
@@ -98,12 +98,6 @@ def test_goto_target_without_a_target_name_fails_saying_so(tmp_path):
                                                          "--set target=NAME)")
 
 
-def true_pose_at(report: dict, stamp: float) -> Pose2D:
-    """The simulator's true pose nearest a time, from a report's decimated trajectory (evaluation only)."""
-    t, x, y, theta = min(report["ground_truth"]["trajectory"], key=lambda row: abs(row[0] - stamp))
-    return Pose2D(x, y, theta)
-
-
 def test_learn_targets_then_goto_target_in_a_small_room(tmp_path, world_file):
     """The whole learning mission (dodecagon, search, homing, graph), then navigation on what it learned."""
     world = world_file(SMALL_ROOM, "small.yaml")
@@ -115,7 +109,7 @@ def test_learn_targets_then_goto_target_in_a_small_room(tmp_path, world_file):
     assert code == 0, data["reason"]
     section = data["roadmap"]
     assert section["connected"] and [(e["from"], e["to"]) for e in section["edges"]] in ([("a", "b")], [("b", "a")])
-    reference = true_pose_at(data, section["room"]["reference_stamp"])
+    reference = TrueTrajectory(data["ground_truth"]).at(section["room"]["reference_stamp"])
     truth = named_poses(world)
     for name, estimate in section["targets"].items():  # the done-when thresholds: 0.15 m, 5 deg
         distance, heading = pose_error(Pose2D(estimate["x"], estimate["y"], math.radians(estimate["theta_deg"])),

@@ -147,3 +147,21 @@ def test_a_long_step_cannot_jump_over_a_thin_wall(sim_from) -> None:
     sim.robot.base.drive(1.2, 0.0)
     sim.step(1.0)
     assert sim.robot.base.stalled() and sim.true_pose().x < 0.6
+
+
+def test_the_report_holds_every_stop_exactly_where_the_trajectory_is_decimated(sim_from) -> None:
+    """A still stretch between two motions is one ``stops`` row: its times and the pose held."""
+    sim = sim_from(ROOM)
+    drive(sim, 0.3, 0.0, 1.0)
+    drive(sim, 0.0, 0.0, 2.0)  # decelerates, then stands
+    still = sim.true_pose()
+    t_still = sim.time
+    drive(sim, 0.0, 0.5, 1.0)  # turns on the spot
+    drive(sim, 0.0, 0.0, 1.0)
+    stops = sim.ground_truth_report()["stops"]
+    middle = [s for s in stops if s[0] <= t_still <= s[1]]
+    assert len(middle) == 1
+    t0, t1, x, y, theta = middle[0]
+    assert 1.0 < t0 < 2.0 and t1 == pytest.approx(t_still, abs=0.051)  # the turn starts at once
+    assert (x, y, theta) == pytest.approx((still.x, still.y, still.theta), abs=1e-4)
+    assert stops[-1][1] == pytest.approx(sim.time) and len(stops) == 2  # and standing at the end
