@@ -95,7 +95,8 @@ def log_map(rec: Any, rr: Any, m: ExplorationMap, border: np.ndarray) -> None:
         rec.log("exploration_3d/interest_edges", rr.LineStrips3D(strips, colors=colours, radii=0.01))
 
 
-HEAD_PORTS = (PAN_RATE, PAN_LIMITS, TILT_LIMITS, VERTICAL_FOV, HORIZONTAL_FOV, PTU_POSITION, CAMERA_POSITION)  # the pan-tilt head's ports
+HEAD_PORTS = (PAN_RATE, PAN_LIMITS, TILT_LIMITS, VERTICAL_FOV, HORIZONTAL_FOV, PTU_POSITION,
+              CAMERA_POSITION)  # the pan-tilt head's ports
 
 
 @register
