@@ -45,6 +45,8 @@ BUILTIN_MODULES = (
     # the roadmap between target images
     *(f"behaviours.roadmap.{m}" for m in ("targets", "calibration", "room", "coverage", "travel", "scan", "homing",
                                           "graph", "navigate")),
+    # exploration with the stereo pair on the pan-tilt unit
+    "behaviours.localise", "behaviours.exploration", "behaviours.follow_path", "behaviours.gaze",
 )  # fmt: skip
 _MARK = "__bearings_node_type__"
 

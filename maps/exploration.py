@@ -191,8 +191,10 @@ class ExplorationMap:
     ``cells``: the :class:`Cell` grid derived from it (uint8); ``points``: (N, 3) float,
     odometry frame; ``edges``: (M, 2) int64 indices into ``points`` (smaller first);
     ``interest``: (M,) uint8 :class:`Interest`; ``visited``: (rows, cols) bool, the cells the
-    robot's centre has been on (:func:`mark_traversed`). Points and edges are only ever appended,
-    so their indices are stable.
+    robot's centre has been on (:func:`mark_traversed`); ``sightings``: (N,) int32, in how many
+    observations each point's voxel was seen (a stereo matcher's stray matches are seen once; a
+    point given without a count counts once). Points and edges are only ever appended, so their
+    indices are stable.
     """
 
     frame: GridFrame
@@ -201,6 +203,7 @@ class ExplorationMap:
     edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     interest: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.uint8))
     visited: np.ndarray | None = None
+    sightings: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int32))
     cells: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -210,9 +213,13 @@ class ExplorationMap:
             raise ValueError("every edge needs an interest state")
         if self.visited is None:
             object.__setattr__(self, "visited", np.zeros(self.frame.shape, dtype=bool))
+        if len(self.sightings) == 0 and len(self.points):  # points given without counts count once
+            object.__setattr__(self, "sightings", np.ones(len(self.points), dtype=np.int32))
+        if len(self.sightings) != len(self.points):
+            raise ValueError("every point needs a count of sightings")
         cells = np.where(self.evidence > 0, Cell.OBSTACLE, np.where(self.evidence < 0, Cell.FREE, Cell.UNKNOWN))
         object.__setattr__(self, "cells", cells.astype(np.uint8))
-        for name in ("evidence", "visited", "cells", "points", "edges", "interest"):
+        for name in ("evidence", "visited", "cells", "points", "edges", "interest", "sightings"):
             object.__setattr__(self, name, _readonly(getattr(self, name)))
 
     @classmethod
@@ -244,7 +251,7 @@ class ExplorationMap:
         return float(np.count_nonzero(self.cells == Cell.FREE)) * self.frame.resolution**2
 
     def _replace(self, **changes: np.ndarray | GridFrame) -> ExplorationMap:
-        names = ("frame", "evidence", "points", "edges", "interest", "visited")
+        names = ("frame", "evidence", "points", "edges", "interest", "visited", "sightings")
         values = {name: getattr(self, name) for name in names}
         values.update(changes)
         return ExplorationMap(**values)
@@ -512,11 +519,13 @@ def integrate_stereo(
     np.clip(evidence, e.low, e.high, out=evidence)
 
     points, index = _merge_points(m.points, world, params.voxel)
+    sightings = np.concatenate([m.sightings, np.zeros(len(points) - len(m.points), dtype=np.int32)])
+    sightings[np.unique(index)] += 1  # once per observation, however many of its points fall in a voxel
     pairs = image_edges(pix, params.max_edge_px)
     r, _, _ = edge_geometry(world[pairs[:, 0]], world[pairs[:, 1]], view.eye, view.heading)
     pairs = pairs[r < params.interest.r_never]  # no depth jump: nothing to look behind, not stored
     edges, interest = _merge_edges(m.edges, m.interest, index[pairs])
-    out = ExplorationMap(frame, evidence, points, edges, interest, visited)
+    out = ExplorationMap(frame, evidence, points, edges, interest, visited, sightings)
     return reevaluate_interest(out, view.eye, view.heading, params.interest, params.max_range)
 
 
@@ -547,15 +556,34 @@ def scan(
     return edges, np.minimum(np.minimum(ranges, params.explore_range), far / np.cos(centre))
 
 
+def observation_scan(
+    points_camera: np.ndarray, view: CameraView, params: IntegrationParams = IntegrationParams()
+) -> tuple[np.ndarray, np.ndarray]:
+    """The virtual range scan (:func:`scan`) of one stereo observation, as :func:`integrate_stereo`
+    draws it: for a record of what was seen that can be drawn again elsewhere (:func:`scan_cells`)."""
+    world = np.asarray(points_camera, dtype=np.float64).reshape(-1, 3) @ view.rotation.T + view.eye
+    plan = np.hypot(world[:, 0] - view.eye[0], world[:, 1] - view.eye[1])
+    ok = np.isfinite(world).all(axis=1) & (plan <= params.max_range)
+    return scan(view, world[ok], plan[ok], params)
+
+
 def _scan_mask(
     frame: GridFrame, view: CameraView, world: np.ndarray, plan: np.ndarray, params: IntegrationParams
 ) -> np.ndarray:
     """The cells (bool) seen as free floor: between the footprint's near edge and each bin's range."""
+    if len(world) == 0:
+        return np.zeros(frame.shape, dtype=bool)
+    edges, ranges = scan(view, world, plan, params)
+    return scan_cells(frame, view, edges, ranges)
+
+
+def scan_cells(frame: GridFrame, view: CameraView, edges: np.ndarray, ranges: np.ndarray) -> np.ndarray:
+    """The cells (bool) a scan (:func:`scan`) saw as free floor from ``view``: between the footprint's
+    near edge and each bin's range."""
     seen = np.zeros(frame.shape, dtype=np.uint8)
     direction, near, _ = footprint(view)
-    if not math.isfinite(near) or len(world) == 0:
+    if not math.isfinite(near):
         return seen.astype(bool)
-    edges, ranges = scan(view, world, plan, params)
     reach = near / np.cos(edges)  # the image's bottom row: a line on the floor across the axis
     c, s = np.cos(edges), np.sin(edges)
     units = np.column_stack((c * direction[0] - s * direction[1], s * direction[0] + c * direction[1]))

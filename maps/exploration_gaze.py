@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from maps.exploration import ExplorationMap, Interest, StereoHead, closer_points
+from maps.exploration import ExplorationMap, Interest, StereoHead
 from perception.geometry import Pose2D, wrap_angles
 
 
@@ -133,13 +133,22 @@ class _Sight:
 
 
 def _sight(gaze: Gaze, m: ExplorationMap, robot: Pose2D, params: GazeParams) -> _Sight:
+    """Only edges that are not *never* are looked at (most of a map's edges end up never: the
+    geometry of the others is not computed, their bearing is inf)."""
     axis = params.head.axis_xy(robot)
-    closer = closer_points(m, np.array([*axis, params.head.lens_height])) if len(m.edges) else np.zeros((0, 3))
-    bearing = pan_to_point(robot, axis, closer[:, :2])
-    reach = (m.interest != Interest.NEVER) & (np.abs(bearing) <= params.max_pan)
+    n = len(m.edges)
+    live = np.flatnonzero(m.interest != Interest.NEVER)
+    closer, bearing, rho = np.zeros((n, 3)), np.full(n, np.inf), np.full(n, np.inf)
+    if len(live):
+        eye = np.array([*axis, params.head.lens_height])
+        a, b = m.points[m.edges[live, 0]], m.points[m.edges[live, 1]]
+        a_closer = np.einsum("ij,ij->i", a - eye, a - eye) <= np.einsum("ij,ij->i", b - eye, b - eye)
+        closer[live] = np.where(a_closer[:, None], a, b)  # as maps.exploration.closer_points
+        bearing[live] = pan_to_point(robot, axis, closer[live, :2])
+        rho[live] = np.hypot(closer[live, 0] - axis[0], closer[live, 1] - axis[1])
+    reach = np.abs(bearing) <= params.max_pan
     if gaze.watched:
         reach[np.fromiter(gaze.watched, dtype=np.int64)] = False
-    rho = np.hypot(closer[:, 0] - axis[0], closer[:, 1] - axis[1])
     return _Sight(closer, bearing, rho, reach, reach & (m.interest == Interest.WATCH_NOW))
 
 

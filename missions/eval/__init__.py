@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import TextIO
 
 AREAS = {
+    "exploration": "missions.eval.exploration",
     "ltmap": "missions.eval.ltmap",
     "roadmap": "missions.eval.roadmap",
 }

@@ -324,3 +324,15 @@ def test_the_robots_trail_stays_traversable_through_a_squeeze():
     assert travel_cost(squeezed, (0.15, 0.15), robot_radius=0.1).at(target)[0] == pytest.approx(0.9)
     forgotten = ExplorationMap(m.frame, evidence)  # the same map without the trail
     assert travel_cost(forgotten, (0.15, 0.15), robot_radius=0.1).at(target)[0] == math.inf
+
+
+def test_sightings_count_the_observations_of_each_voxel():
+    m = ExplorationMap.empty(resolution=0.1, half_size=2.0)
+    view = SIMPLE.view(Pose2D(), 0.0, math.radians(-45.0))
+    pts = np.array([[2.0, 0.0, -0.5], [2.01, 0.0, -0.5], [2.5, 0.5, -0.2]])  # the first two share a voxel
+    uv = np.array([[0.0, 0.0], [100.0, 0.0], [200.0, 0.0]])
+    once = integrate_stereo(m, pts, uv, view)
+    assert once.sightings.tolist() == [1, 1]
+    twice = integrate_stereo(once, pts[:1], uv[:1], view)
+    assert twice.sightings.tolist() == [2, 1]
+    assert ExplorationMap(m.frame, m.evidence, points=pts).sightings.tolist() == [1, 1, 1]

@@ -7,8 +7,16 @@ import math
 import numpy as np
 import pytest
 
-from maps.exploration import Cell, ExplorationMap, GridFrame
-from maps.exploration_goal import GoalParams, Mode, ModeSwitch, attractive_power, candidates, select_goal
+from maps.exploration import Cell, ExplorationMap, GridFrame, traversable
+from maps.exploration_goal import (
+    GoalParams,
+    Mode,
+    ModeSwitch,
+    attractive_power,
+    candidates,
+    select_goal,
+    verification_goal,
+)
 
 NO_RADIUS = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1)
 ROBOT = (0.25, 0.55)  # the centre of cell (row 5, col 2)
@@ -129,3 +137,97 @@ def test_patience_gives_no_goal_before_done():
 def test_selection_needs_the_robots_footprint_first():
     with pytest.raises(ValueError, match="footprint"):
         select_goal(ModeSwitch(), ExplorationMap.empty(resolution=0.1, half_size=1.0), (0.0, 0.0))
+
+
+def test_points_seen_once_do_not_attract_with_min_sightings():
+    m = explored_strip([P1, P2])
+    m = ExplorationMap(m.frame, m.evidence, m.points, visited=m.visited, sightings=np.array([1, 3], dtype=np.int32))
+    params = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, min_sightings=2)
+    found = candidates(m, ROBOT, params)
+    assert found.distance == pytest.approx([0.0, 1.55])
+    _, goal = select_goal(ModeSwitch(), m, ROBOT, params)
+    assert goal is not None and goal.point == 1
+
+
+def test_the_current_goal_is_kept_within_the_hysteresis():
+    m = explored_strip([P1, P2])  # A_P: P1 1.625, P2 1.45
+    _, best = select_goal(ModeSwitch(), m, ROBOT, NO_RADIUS)
+    assert best is not None and best.point == 0
+    _, current = select_goal(ModeSwitch().spend(0), m, ROBOT, NO_RADIUS)
+    assert current is not None and current.point == 1
+    keep = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, hysteresis=0.2)
+    _, goal = select_goal(ModeSwitch(), m, ROBOT, keep, current=current)
+    assert goal is not None and goal.point == 1  # 1.45 is within 0.2 of 1.625
+    tight = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, hysteresis=0.1)
+    _, goal = select_goal(ModeSwitch(), m, ROBOT, tight, current=current)
+    assert goal is not None and goal.point == 0
+
+
+def test_avoided_targets_are_no_candidates_and_the_baseline_ignores_points():
+    m = explored_strip([P1, P2])
+    found = candidates(m, ROBOT, NO_RADIUS, avoid=np.array([[1.95, 0.55]]))
+    assert np.min(np.hypot(*(found.border - [1.95, 0.55]).T)) > NO_RADIUS.avoid_radius
+    baseline = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, closest_frontier=True)
+    switch, goal = select_goal(ModeSwitch(), m, ROBOT, baseline)
+    assert switch.mode is Mode.FRONTIER and goal is not None and goal.cost == pytest.approx(0.2)
+
+
+def test_points_next_to_obstacles_do_not_attract_with_a_point_clearance():
+    m = explored_strip([[2.15, 0.25, 2.0], [4.0, 0.85, 0.5]], walled=True)  # atop the east wall; farther east
+    cells = m.cells.copy()
+    cells[7:11, 21] = Cell.UNKNOWN  # a gap in the east wall (y 0.6 - 1.0): the strip has a border there
+    m = ExplorationMap.from_cells(m.frame, cells, points=m.points)
+    params = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, point_clearance=0.3)
+    found = candidates(m, ROBOT, params)
+    assert found.distance[0] == 0.0 and found.distance[1] > 1.0
+
+
+def doorway(speckle: bool, points: bool = True) -> ExplorationMap:
+    """A walled room [0, 3] x [0, 2] (0.1 m cells) with a 0.8 m door in its east wall at y 0.6-1.4
+    and a walled passage beyond, explored for 0.4 m (x 3.1-3.5), unknown after; ``speckle``: a 2 x 2
+    obstacle clump in the passage at (3.2-3.4, 0.9-1.1), which leaves gaps of 0.3 m either side;
+    ``points``: a point seen 1.15 m beyond the border (something to explore there)."""
+    cells = np.zeros((23, 51), dtype=np.uint8)  # frame x0 = y0 = -0.1: cell (r, c) centre (c/10 - 0.05, r/10 - 0.05)
+    cells[1:21, 1:31] = Cell.FREE  # the room
+    cells[[0, 21], 0:32] = Cell.OBSTACLE
+    cells[0:22, [0, 31]] = Cell.OBSTACLE
+    cells[7:15, 31] = Cell.FREE  # the door, y 0.6-1.4
+    cells[7:15, 32:36] = Cell.FREE  # explored beyond it
+    cells[[6, 15], 32:36] = Cell.OBSTACLE  # the passage's walls
+    if speckle:
+        cells[10:12, 33:35] = Cell.OBSTACLE
+    beyond = np.array([[4.6, 1.05, 0.5]])  # a point seen through the door, 1.15 m beyond the border
+    return ExplorationMap.from_cells(GridFrame(-0.1, -0.1, 0.1, 23, 51), cells,
+                                     points=beyond if points else np.zeros((0, 3)))
+
+
+VERIFY = GoalParams(robot_radius=0.26, min_frontier=0.1, verify_radius=0.1, look_back=1.0)
+
+
+def test_a_border_closed_by_a_clump_is_looked_at_again_from_look_back_before_it():
+    m, robot = doorway(speckle=True), (0.55, 1.05)
+    switch, goal = select_goal(ModeSwitch(), m, robot, VERIFY)
+    assert goal is None and switch.strikes == 1  # the robot's disc passes no gap: no border is reachable
+    goal = verification_goal(m, robot, VERIFY)
+    assert goal is not None and goal.mode is Mode.VERIFY and goal.blocked is not None
+    # the first cell of the narrow path the robot's disc cannot pass is at the door (within 0.26 of
+    # the clump or a jamb); the goal lies 1 m of path before it, inside the room
+    assert 2.9 <= goal.blocked[0] <= 3.1
+    passable = traversable(m, 0.26)
+    rows, cols = m.frame.cell_of(np.array([goal.target]))
+    assert passable[rows[0], cols[0]]
+    assert 1.7 <= goal.target[0] <= 2.2 and goal.path[-1] == pytest.approx(goal.target)
+
+
+def test_nothing_to_verify_without_the_clump_or_once_verified_or_when_off():
+    robot = (0.55, 1.05)
+    clear = doorway(speckle=False)
+    _, goal = select_goal(ModeSwitch(), clear, robot, VERIFY)
+    assert goal is not None and goal.mode is Mode.ATTRACTION  # the door itself is passable
+    m = doorway(speckle=True)
+    blocked = verification_goal(m, robot, VERIFY)
+    assert blocked is not None and blocked.blocked is not None
+    assert verification_goal(m, robot, VERIFY, verified=np.array([blocked.blocked])) is None
+    assert verification_goal(m, robot, VERIFY, avoid=np.array([[3.45, y] for y in (0.75, 1.05, 1.35)])) is None
+    assert verification_goal(m, robot, GoalParams(robot_radius=0.26, min_frontier=0.1)) is None
+    assert verification_goal(doorway(speckle=True, points=False), robot, VERIFY) is None  # nothing seen beyond

@@ -42,10 +42,11 @@ SHIPPED = sorted(LIBRARY.glob("*.yaml"))
 
 EVERY_NODE_TYPE = """
     mission: every_node_type
-    cameras: [panorama]
+    cameras: [panorama, stereo, landmarks]
     sense:
       - Perceive: {camera: panorama, max_features: 300, observation: "{/perception/panorama}"}
       - CorrectOdometry
+      - LocalisePose: {camera: landmarks}
     tree:
       Sequence:
         name: every node type
@@ -130,6 +131,20 @@ EVERY_NODE_TYPE = """
                 - BuildGraph: {file: learned.roadmap, odometry: "{/robot/calibrated_odometry}"}
                 - LoadRoadmap: {file: learned.roadmap}
                 - NavigateToTarget: {target: door}
+          - Parallel:
+              name: the exploration nodes
+              policy: one
+              children:
+                - MapStereo: {camera: stereo, odometry: "{/robot/pose}"}
+                - Sequence:
+                    children:
+                      - LookAround
+                      - Parallel:
+                          policy: one
+                          children:
+                            - SelectGoalPoint: {odometry: "{/robot/pose}"}
+                            - FollowPath: {odometry: "{/robot/pose}"}
+                            - WatchInterestEdges: {turn_rate: "{/robot/command.w}", odometry: "{/robot/pose}"}
           - Stop
 """
 
