@@ -5,9 +5,10 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from pathlib import Path
 
 from drivers.sim.world_file import MAX_COORD
-from maps.store import Diagnostic, InputError
+from maps.store import Diagnostic, InputError, output_problem, write_text_atomic
 from missions.language import MissionSpec
 from missions.loader import load_mission
 from perception.geometry import Pose2D
@@ -78,3 +79,16 @@ def parse_pose(text: str, named: dict[str, Pose2D], *, option: str) -> Pose2D:
     if max(abs(x), abs(y)) > MAX_COORD:
         raise ValueError(f"{option}: x and y must be within {MAX_COORD:g} m (the extent of any world), got {text!r}")
     return Pose2D(x, y, theta)
+
+
+def emit(command: str, text: str, output: Path | None) -> int:
+    """Write a command's result to ``output`` (atomically) or to stdout; exit 2 with the reason when
+    ``output`` cannot be written."""
+    if output is None:
+        sys.stdout.write(text)
+        return EXIT_OK
+    problem = output_problem(output)
+    if problem:
+        return fail(command, f"cannot write {output}: {problem}")
+    write_text_atomic(output, text)
+    return EXIT_OK

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
-from maps.store import InputError, output_problem, write_text_atomic
-from missions.commands.common import EXIT_OK, fail, print_input_error
+from maps.store import InputError, output_problem
+from missions.commands.common import emit, fail, print_input_error
 from missions.importer import import_btcpp
 
 DESCRIPTION = """Turn a BehaviorTree.CPP v4 XML file (as Groot2 saves it: several <BehaviorTree>s with
@@ -36,8 +35,4 @@ def run(args: argparse.Namespace) -> int:
         text = import_btcpp(args.tree)
     except InputError as exc:
         return print_input_error(exc)
-    if args.output:
-        write_text_atomic(args.output, text)
-    else:
-        sys.stdout.write(text)
-    return EXIT_OK
+    return emit("import", text, args.output)

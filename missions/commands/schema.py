@@ -4,11 +4,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from typing import Any
 
-from maps.store import write_text_atomic
-from missions.commands.common import EXIT_OK, fail
+from missions.commands.common import emit, fail
 
 DESCRIPTION = """Print a JSON Schema (draft 2020-12) for editors to complete and check files.
 
@@ -36,11 +34,7 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         return fail("schema", str(exc))
     text = json.dumps(schema, indent=2) + "\n"
-    if args.output:
-        write_text_atomic(args.output, text)
-    else:
-        sys.stdout.write(text)
-    return EXIT_OK
+    return emit("schema", text, args.output)
 
 
 def _schema(args: argparse.Namespace) -> dict[str, Any]:

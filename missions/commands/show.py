@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
-from maps.store import InputError, write_text_atomic
-from missions.commands.common import EXIT_OK, add_mission_options, load_from_args, print_input_error
+from maps.store import InputError
+from missions.commands.common import add_mission_options, emit, load_from_args, print_input_error
 from missions.export import btcpp_xml, dot_tree, unicode_tree
 
 FORMATS = {"unicode": unicode_tree, "dot": dot_tree, "xml": btcpp_xml}
@@ -31,8 +30,4 @@ def run(args: argparse.Namespace) -> int:
         text = FORMATS[args.format](mission)  # the XML export refuses what BT.CPP cannot express
     except InputError as exc:
         return print_input_error(exc)
-    if args.output:
-        write_text_atomic(args.output, text)
-    else:
-        sys.stdout.write(text)
-    return EXIT_OK
+    return emit("show", text, args.output)

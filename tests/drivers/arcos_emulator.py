@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 from drivers import arcos
 from drivers.arcos import Command, Identity
+from tests.drivers.emulator_thread import EmulatorThread
 
 
 @dataclass(frozen=True)
@@ -37,12 +38,15 @@ class Event:
     arg: int | bytes | None = None
 
 
-class ArcosEmulator:
+class ArcosEmulator(EmulatorThread):
+    THREAD_NAME = "arcos-emulator"
+
     def __init__(self, *, transport: str = "pty", model: str = "p3dx", identity: Identity | None = None,
                  sip_period: float = 0.1, watchdog: float = 2.0, time_scale: float = 1.0,
                  start_pose: tuple[float, float, float] = (0.0, 0.0, 0.0), reply_delay: float = 0.0,
                  send_config: bool = True, start_open: bool = False, new_firmware: bool = True,
                  sync_glitch: int = 0, seed: int = 0) -> None:
+        super().__init__()
         self.transport = transport
         self.params = arcos.MODELS[model]
         self.identity = identity or Identity("emulator", "Pioneer", model)
@@ -84,8 +88,6 @@ class ArcosEmulator:
         self._outbox: list[tuple[float, bytes]] = []
         self._reader = arcos.PacketReader()
         self._lock = threading.RLock()
-        self._running = threading.Event()
-        self._thread: threading.Thread | None = None
         self._next_sip = time.monotonic()
         self._last_step = time.monotonic()
         # the link
@@ -109,27 +111,13 @@ class ArcosEmulator:
         self._listener = listener
         return f"socket://127.0.0.1:{listener.getsockname()[1]}"
 
-    def start(self) -> ArcosEmulator:
-        self._running.set()
-        self._thread = threading.Thread(target=self._loop, name="arcos-emulator", daemon=True)
-        self._thread.start()
-        return self
-
-    def close(self) -> None:
-        self._running.clear()
-        if self._thread is not None:
-            self._thread.join(timeout=2.0)
+    def _release(self) -> None:
         self._close_link()
         if self._listener is not None:
             with contextlib.suppress(OSError):
                 self._listener.close()
             self._listener = None
 
-    def __enter__(self) -> ArcosEmulator:
-        return self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
     # -- faults ------------------------------------------------------------------------------------
     def garbage(self, n: int = 64) -> None:

@@ -19,6 +19,7 @@ import tty
 from dataclasses import dataclass
 
 from drivers import ptu_d46_codec as codec
+from tests.drivers.emulator_thread import EmulatorThread
 
 BANNER = "PTU-D46 Controller (C) 1988-2010 DPerception, Inc. All Rights Reserved. v2.14.0"
 
@@ -47,11 +48,14 @@ class Axis:
         self.position = self.target if abs(gap) <= travel else self.position + travel * (1 if gap > 0 else -1)
 
 
-class PtuEmulator:
+class PtuEmulator(EmulatorThread):
+    THREAD_NAME = "ptu-emulator"
+
     def __init__(self, *, pan_resolution: float = 185.1428, tilt_resolution: float = 185.1428,
                  pan_limits: tuple[int, int] = (-3090, 3090), tilt_limits: tuple[int, int] = (-907, 604),
                  speed_bounds: tuple[int, int] = (57, 2902), time_scale: float = 1.0, reply_delay: float = 0.0,
                  banner: bool = True) -> None:
+        super().__init__()
         self.axes = {"P": Axis(pan_resolution, *pan_limits, *speed_bounds),
                      "T": Axis(tilt_resolution, *tilt_limits, *speed_bounds)}
         self.time_scale = time_scale
@@ -66,8 +70,6 @@ class PtuEmulator:
         self._text = ""
         self._outbox: list[tuple[float, bytes]] = []
         self._lock = threading.RLock()
-        self._running = threading.Event()
-        self._thread: threading.Thread | None = None
         self._last_step = time.monotonic()
         self._master, self._slave = os.openpty()
         tty.setraw(self._slave)
@@ -77,23 +79,9 @@ class PtuEmulator:
             self._write(f"{BANNER}\r\n".encode())
 
     # -- life cycle ----------------------------------------------------------------------------------
-    def start(self) -> PtuEmulator:
-        self._running.set()
-        self._thread = threading.Thread(target=self._loop, name="ptu-emulator", daemon=True)
-        self._thread.start()
-        return self
-
-    def close(self) -> None:
-        self._running.clear()
-        if self._thread is not None:
-            self._thread.join(timeout=2.0)
+    def _release(self) -> None:
         self.drop_link()
 
-    def __enter__(self) -> PtuEmulator:
-        return self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
     # -- faults and queries --------------------------------------------------------------------------
     def drop_link(self) -> None:
