@@ -43,6 +43,9 @@ from perception.geometry import Pose2D
 
 ROBOT_RADIUS = InputPort("robot_radius", float, 0.26, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
                          doc="radius of the robot's disc")
+CLEARANCE = InputPort("clearance", float, 0.05, unit="m", minimum=0.0, maximum=1.0, literal_only=True,
+                      doc="room kept between the disc and obstacle cells beyond robot_radius (localisation "
+                          "error): paths are planned with it, and FollowPath stops the robot short of it")
 MAP = InputPort("map", ExplorationMap, Ref("/map/exploration"), doc="the exploration map")
 GOAL = InputPort("goal", Goal, Ref("/map/exploration_goal"), doc="the exploration goal (None: none)")
 POSE = InputPort("odometry", Pose2D, Ref("/robot/odometry"),
@@ -295,8 +298,9 @@ class SelectGoalPoint(BearingsBehaviour):
         InputPort("k", float, 1.0, unit="m", minimum=0.0, maximum=100.0, literal_only=True,
                   doc="a point must lie this far beyond the border to attract"),
         ROBOT_RADIUS,
+        CLEARANCE,
         InputPort("margin", float, 0.3, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
-                  doc="paths with less clearance than robot_radius + margin cost more"),
+                  doc="paths with less clearance than robot_radius + clearance + margin cost more"),
         InputPort("penalty", float, 3.0, minimum=0.0, maximum=100.0, literal_only=True,
                   doc="...up to (1 + penalty) times their length"),
         InputPort("patience", int, 2, minimum=1, maximum=100, literal_only=True,
@@ -326,7 +330,8 @@ class SelectGoalPoint(BearingsBehaviour):
         super().__init__(name=name, **ports)
         self.params = GoalParams(
             eta=float(self.get_input("eta")), k=float(self.get_input("k")),
-            robot_radius=float(self.get_input("robot_radius")), min_frontier=float(self.get_input("min_frontier")),
+            robot_radius=float(self.get_input("robot_radius")) + float(self.get_input("clearance")),
+            min_frontier=float(self.get_input("min_frontier")),
             margin=float(self.get_input("margin")), penalty=float(self.get_input("penalty")),
             patience=int(self.get_input("patience")), hysteresis=float(self.get_input("hysteresis")),
             closest_frontier=self.get_input("strategy") == "closest_frontier",

@@ -55,7 +55,7 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.exploration import GOAL, MAP, POSE, ROBOT_RADIUS
+from behaviours.exploration import CLEARANCE, GOAL, MAP, POSE, ROBOT_RADIUS
 from behaviours.motion import ANGULAR_DECEL, COMMAND, LINEAR_DECEL, STALLED, ramp
 from behaviours.ports import InputPort, OutputPort
 from behaviours.registry import register
@@ -139,8 +139,7 @@ class FollowPath(BearingsBehaviour):
                   doc="turn on the spot when the carrot is this far off the heading"),
         InputPort("check_distance", float, 0.8, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
                   doc="how much of the path ahead must stay clear"),
-        InputPort("clearance", float, 0.05, unit="m", minimum=0.0, maximum=1.0, literal_only=True,
-                  doc="extra room kept between the disc and obstacle cells when moving (localisation error)"),
+        CLEARANCE,
         ROBOT_RADIUS,
         InputPort("margin", float, 0.3, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
                   doc="re-planned paths: steps with less clearance than robot_radius + margin cost more"),
@@ -230,7 +229,8 @@ class FollowPath(BearingsBehaviour):
             return Status.RUNNING
         if self._blocked(m):
             self.replans += 1
-            travel = travel_cost(m, (pose.x, pose.y), float(self.get_input("robot_radius")),
+            planned = float(self.get_input("robot_radius")) + float(self.get_input("clearance"))
+            travel = travel_cost(m, (pose.x, pose.y), planned,
                                  margin=float(self.get_input("margin")), penalty=float(self.get_input("penalty")))
             self.path, self.index = travel.path_to(goal.target), 0
             if len(self.path) == 0 or self._blocked(m):
