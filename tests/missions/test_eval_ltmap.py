@@ -4,6 +4,7 @@ rendered-panorama tables of lab and outdoor are measured by hand)."""
 
 from __future__ import annotations
 
+import importlib
 import json
 import math
 
@@ -12,6 +13,7 @@ import pytest
 
 from drivers.sim.world import load_world
 from missions.cli import main
+from missions.eval import AREAS
 from missions.eval.ltmap import (
     Level,
     check_options,
@@ -171,3 +173,12 @@ def test_a_teach_that_fails_leaves_nothing_to_repeat(world_file, tmp_path, capsy
     assert figures["taught"] == 0 and figures["rows"] == [] and figures["repeats"] == 0
     assert figures["teach_failed"][0]["problem"].startswith("FAILURE")
     assert "seed 0: no map to repeat (FAILURE" in format_table(figures)
+
+
+def test_the_help_names_every_option_each_area_declares(capsys):
+    with pytest.raises(SystemExit):
+        main(["eval", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for area, module in AREAS.items():
+        options = getattr(importlib.import_module(module), "OPTIONS", {})
+        assert area in text and all(name in text for name in options), area
