@@ -25,25 +25,30 @@ import io
 import math
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
 import yaml
+from scipy import ndimage
 
 from drivers.sim.cameras import camera_pose
 from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, load_world, shipped_worlds
-from perception.geometry import Pose2D, wrap_angle
+from perception.geometry import Pose2D, wrap_angle, wrap_angles
 
-START_CLEARANCE = 0.45  # m: a random start (and a placed target) is at least this far from any wall, box or pillar
+START_CLEARANCE = 0.45  # m: a random start is at least this far from any wall, box or pillar
+TARGET_CLEARANCE = 0.7  # m: a placed target too, when the world has room (else START_CLEARANCE): open floor around it
 MAX_DRAWS = 100_000  # random positions tried per start (per placed target) before giving up (a world with no room)
 TARGET_SPACING = 1.5  # m: placed targets at least this far apart (distinct places, not one view twice)
 VIEW_RANGE = (1.0, 5.0)  # m: a placed target's camera sees surfaces this far away on every ray
 VIEW_RAYS = 7  # rays across the camera's centre row that must all see a surface in range
 HEADINGS = 24  # candidate headings of a placed target (every 15 deg)
 MIN_SURFACES = 2  # distinct surfaces a placed target's view must meet (one flat wall: the planar ambiguity)
+TARGET_CANDIDATES = 3  # positions drawn per placed target; the one with the best view is kept
+PREFERRED_CENTRE = (2.0, 4.0)  # m: a placed target's optical axis preferably meets its surface this far away
 
 T = TypeVar("T")
 
@@ -166,6 +171,11 @@ class FreeFloor:
     def of(cls, world: World, clearance: float, grid: FloorGrid | None = None) -> FreeFloor:
         return cls(world, grid or reachable_grid(world), Scene(world), clearance)
 
+    @cached_property
+    def cells(self) -> np.ndarray:
+        """Centres of the reachable cells (:func:`floor_cells`), for the placed targets' floor in view."""
+        return floor_cells(self.grid)
+
     def is_free(self, x: float, y: float) -> bool:
         """Whether (x, y) is reachable and clear enough."""
         row, col, inside = self.grid.cells_of(np.array([x, y]))
@@ -250,50 +260,143 @@ def camera_view(scene: Scene, world: World, pose: Pose2D, azimuths: np.ndarray, 
                 tuple(int(index[k]) if math.isfinite(d) else -1 for k, d in zip(nearest, hit, strict=True)))
 
 
-def best_heading(scene: Scene, world: World, x: float, y: float, azimuths: np.ndarray, *,
-                 view_range: tuple[float, float] = VIEW_RANGE, camera: str = "front") -> float | None:
-    """Of ``HEADINGS`` headings evenly round, among those whose view is within ``view_range`` on
-    every ray and meets at least ``MIN_SURFACES`` distinct surfaces (a single flat wall is the
-    planar essential matrix's ambiguous case: homing to it may fail), the one that meets the most,
-    then whose optical axis is nearest the middle of the range; None if none qualifies."""
+def floor_cells(grid: FloorGrid) -> np.ndarray:
+    """World (x, y) of the centres of the grid's reachable cells (N x 2): where the robot can stand."""
+    rows, cols = np.nonzero(grid.reachable)
+    return np.column_stack([grid.x0 + (cols + 0.5) * grid.resolution, grid.y0 + (rows + 0.5) * grid.resolution])
+
+
+def floor_in_view(cells: np.ndarray, cell_area: float, eye: np.ndarray, psi: float, azimuths: np.ndarray,
+                  view: View) -> float:
+    """m^2 of reachable floor (``cells``, :func:`floor_cells`) inside the camera's field of view
+    between its eye (x, y) and the surfaces ``view`` meets: between the outermost rays, no farther
+    than the distance to the surface at that bearing (interpolated between the rays). A robot
+    standing there on the line of sight, facing the same way, sees the same scene nearer or
+    farther: the larger this floor, the more places a scan can match the target image from."""
+    order = np.argsort(azimuths)
+    rays, reach = azimuths[order], np.asarray(view.distances)[order]
+    rel = cells - np.asarray(eye[:2])[None, :]
+    bearing = wrap_angles(np.arctan2(rel[:, 1], rel[:, 0]) - psi)
+    ahead = (bearing >= rays[0]) & (bearing <= rays[-1])
+    seen = ahead & (np.hypot(rel[:, 0], rel[:, 1]) <= np.interp(bearing, rays, reach))
+    return float(np.count_nonzero(seen)) * cell_area
+
+
+@dataclass(frozen=True)
+class HeadingChoice:
+    """A qualifying heading of a placed target (:func:`heading_choices`): what its camera sees and
+    how much floor the robot can stand on inside that view (:func:`floor_in_view`)."""
+
+    theta: float
+    view: View
+    floor: float  # m^2
+
+    @property
+    def surfaces(self) -> int:
+        """Distinct surfaces the view meets."""
+        return len(set(self.view.surfaces))
+
+    def preferred(self, band: tuple[float, float] = PREFERRED_CENTRE) -> bool:
+        """Whether the optical axis meets its surface within ``band`` (m)."""
+        return band[0] <= self.view.centre <= band[1]
+
+    def key(self, band: tuple[float, float] = PREFERRED_CENTRE) -> tuple[bool, float, int, float]:
+        """The order of preference (largest best): centre distance in the band, then floor in view,
+        then surfaces met, then the optical axis nearest the band's middle."""
+        return (self.preferred(band), self.floor, self.surfaces, -abs(self.view.centre - sum(band) / 2.0))
+
+
+def heading_choices(free: FreeFloor, x: float, y: float, azimuths: np.ndarray, *,
+                    view_range: tuple[float, float] = VIEW_RANGE, camera: str = "front") -> list[HeadingChoice]:
+    """Of ``HEADINGS`` headings evenly round from (x, y), those whose view is within ``view_range`` on
+    every ray and meets at least ``MIN_SURFACES`` distinct surfaces (a single flat wall is the planar
+    essential matrix's ambiguous case: homing to it may fail), each with its floor in view."""
     near, far = view_range
-    best: tuple[int, float] | None = None
-    chosen = None
+    spec, cells, area = free.world.camera(camera), free.cells, free.grid.resolution**2
+    choices = []
     for k in range(HEADINGS):
-        theta = wrap_angle(2.0 * math.pi * k / HEADINGS)
-        view = camera_view(scene, world, Pose2D(x, y, theta), azimuths, camera)
-        surfaces = len(set(view.surfaces))
-        if not view.within(near, far) or surfaces < MIN_SURFACES:
+        pose = Pose2D(x, y, wrap_angle(2.0 * math.pi * k / HEADINGS))
+        view = camera_view(free.scene, free.world, pose, azimuths, camera)
+        if not view.within(near, far) or len(set(view.surfaces)) < MIN_SURFACES:
             continue
-        score = (surfaces, -abs(view.centre - (near + far) / 2.0))
-        if best is None or score > best:
-            best, chosen = score, theta
-    return chosen
+        where = camera_pose(spec, free.world.ptu, pose)
+        choices.append(HeadingChoice(pose.theta, view, floor_in_view(cells, area, where.eye, where.psi, azimuths,
+                                                                     view)))
+    return choices
 
 
-def place_targets(world: World, count: int, seed: int, *, clearance: float = START_CLEARANCE,
-                  spacing: float = TARGET_SPACING, view_range: tuple[float, float] = VIEW_RANGE,
-                  camera: str = "front", grid: FloorGrid | None = None) -> dict[str, Pose2D]:
-    """``count`` target poses ``t1``..``tN`` drawn from ``seed`` alone: free positions (as the random
-    starts: reachable, ``clearance`` from every surface), at least ``spacing`` apart, each with the
-    heading :func:`best_heading` chooses (a position where none is good is drawn again). The first
-    ones do not depend on ``count``. ``ValueError`` when the world has no room for them all."""
-    free = FreeFloor.of(world, clearance, grid)
-    azimuths = camera_rays(world, camera)
+def best_heading(free: FreeFloor, x: float, y: float, azimuths: np.ndarray, *,
+                 view_range: tuple[float, float] = VIEW_RANGE, camera: str = "front") -> HeadingChoice | None:
+    """The qualifying heading (:func:`heading_choices`) the search can find most easily: optical axis
+    ``PREFERRED_CENTRE`` away if any is, then the most floor in view, then the most surfaces, then the
+    axis nearest the band's middle (:meth:`HeadingChoice.key`); None if none qualifies."""
+    choices = heading_choices(free, x, y, azimuths, view_range=view_range, camera=camera)
+    return max(choices, key=HeadingChoice.key) if choices else None
+
+
+def has_room(grid: FloorGrid, clearance: float) -> bool:
+    """Whether some reachable cell may be ``clearance`` from every wall, box and pillar (the grid's
+    distance transform, generous by a cell: a quick test before drawing positions for it)."""
+    distance = ndimage.distance_transform_edt(grid.free) * grid.resolution
+    return bool(np.any(grid.reachable) and distance[grid.reachable].max() + grid.resolution >= clearance)
+
+
+def place_targets(world: World, count: int, seed: int, *, clearance: float = TARGET_CLEARANCE,
+                  fallback: float = START_CLEARANCE, spacing: float = TARGET_SPACING,
+                  view_range: tuple[float, float] = VIEW_RANGE, camera: str = "front",
+                  grid: FloorGrid | None = None) -> dict[str, Pose2D]:
+    """``count`` target poses ``t1``..``tN`` drawn from ``seed`` alone: free positions (reachable,
+    ``clearance`` from every surface: room around a target; when the world has no room for them all
+    so, ``fallback``, the random starts' clearance), at least ``spacing`` apart, each with the
+    heading :func:`best_heading` chooses (a position where none qualifies is drawn again). The
+    first ones do not depend on ``count``. ``ValueError`` when the world has no room for them all."""
+    grid = grid or reachable_grid(world)
+    tries = [clearance, fallback] if fallback < clearance else [clearance]
+    if len(tries) > 1 and not has_room(grid, clearance):
+        tries = tries[1:]
+    failure = ValueError("no clearance to try")
+    for clear in tries:
+        try:
+            return _place(FreeFloor.of(world, clear, grid), count, seed, spacing=spacing, view_range=view_range,
+                          camera=camera)
+        except ValueError as exc:
+            failure = exc
+    raise failure
+
+
+def _place(free: FreeFloor, count: int, seed: int, *, spacing: float, view_range: tuple[float, float],
+           camera: str) -> dict[str, Pose2D]:
+    """:func:`place_targets` at one clearance (``free``'s): per target, of ``TARGET_CANDIDATES``
+    positions drawn one after the other, the one whose best heading ranks first."""
+    azimuths = camera_rays(free.world, camera)
     rng = np.random.default_rng([seed, 0x60A3])
     placed: dict[str, Pose2D] = {}
 
-    def judge(x: float, y: float) -> Pose2D | None:
+    def judge(x: float, y: float) -> tuple[Pose2D, HeadingChoice] | None:
         if any(math.hypot(x - p.x, y - p.y) < spacing for p in placed.values()):
             return None
-        theta = best_heading(free.scene, world, x, y, azimuths, view_range=view_range, camera=camera)
-        return None if theta is None else Pose2D(x, y, theta)
+        best = best_heading(free, x, y, azimuths, view_range=view_range, camera=camera)
+        return None if best is None else (Pose2D(x, y, best.theta), best)
 
     for k in range(1, count + 1):
-        pose = free.draw(rng, judge)
-        if pose is None:
-            raise ValueError(f"world {world.name!r} has room for {len(placed)} target(s), not {count}: reachable, "
-                             f"{clearance:g} m clear, {spacing:g} m apart, the {camera} camera facing surfaces "
-                             f"{view_range[0]:g}-{view_range[1]:g} m away")
-        placed[f"t{k}"] = pose
+        chosen = _best_of(free, rng, judge, TARGET_CANDIDATES)
+        if chosen is None:
+            raise ValueError(f"world {free.world.name!r} has room for {len(placed)} target(s), not {count}: "
+                             f"reachable, {free.clearance:g} m clear, {spacing:g} m apart, the {camera} camera "
+                             f"facing surfaces {view_range[0]:g}-{view_range[1]:g} m away")
+        placed[f"t{k}"] = chosen
     return placed
+
+
+def _best_of(free: FreeFloor, rng: np.random.Generator,
+             judge: Callable[[float, float], tuple[Pose2D, HeadingChoice] | None], tries: int) -> Pose2D | None:
+    """Of up to ``tries`` positions drawn one after the other (:meth:`FreeFloor.draw`), the pose whose
+    heading ranks first (:meth:`HeadingChoice.key`; the earlier one on a tie); None when the first
+    draw finds none (fewer when a later one finds none)."""
+    drawn: list[tuple[Pose2D, HeadingChoice]] = []
+    for _ in range(tries):
+        found = free.draw(rng, judge)
+        if found is None:
+            break
+        drawn.append(found)
+    return max(drawn, key=lambda d: d[1].key())[0] if drawn else None
