@@ -47,6 +47,7 @@ VIEW_RANGE = (1.0, 5.0)  # m: a placed target's camera sees surfaces this far aw
 VIEW_RAYS = 7  # rays across the camera's centre row that must all see a surface in range
 HEADINGS = 24  # candidate headings of a placed target (every 15 deg)
 MIN_SURFACES = 2  # distinct surfaces a placed target's view must meet (one flat wall: the planar ambiguity)
+TARGET_DRAWS = 10_000  # draws for a placed target at TARGET_CLEARANCE before START_CLEARANCE is tried
 TARGET_CANDIDATES = 3  # positions drawn per placed target; the one with the best view is kept
 PREFERRED_CENTRE = (2.0, 4.0)  # m: a placed target's optical axis preferably meets its surface this far away
 
@@ -181,11 +182,12 @@ class FreeFloor:
         row, col, inside = self.grid.cells_of(np.array([x, y]))
         return bool(inside[0] and self.grid.reachable[row[0], col[0]]) and self.scene.clearance(x, y) >= self.clearance
 
-    def draw(self, rng: np.random.Generator, judge: Callable[[float, float], T | None]) -> T | None:
-        """The first of up to ``MAX_DRAWS`` positions uniform in the world's bounds that is free and
+    def draw(self, rng: np.random.Generator, judge: Callable[[float, float], T | None],
+             draws: int = MAX_DRAWS) -> T | None:
+        """The first of up to ``draws`` positions uniform in the world's bounds that is free and
         that ``judge`` accepts (its answer); None when none is."""
         xmin, ymin, xmax, ymax = self.world.bounds()
-        for _ in range(MAX_DRAWS):
+        for _ in range(draws):
             x, y = float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax))
             if self.is_free(x, y):
                 judged = judge(x, y)
@@ -346,57 +348,65 @@ def place_targets(world: World, count: int, seed: int, *, clearance: float = TAR
                   view_range: tuple[float, float] = VIEW_RANGE, camera: str = "front",
                   grid: FloorGrid | None = None) -> dict[str, Pose2D]:
     """``count`` target poses ``t1``..``tN`` drawn from ``seed`` alone: free positions (reachable,
-    ``clearance`` from every surface: room around a target; when the world has no room for them all
-    so, ``fallback``, the random starts' clearance), at least ``spacing`` apart, each with the
-    heading :func:`best_heading` chooses (a position where none qualifies is drawn again). The
-    first ones do not depend on ``count``. ``ValueError`` when the world has no room for them all."""
+    ``clearance`` from every surface: room around a target; ``fallback``, the random starts'
+    clearance, for a target when ``TARGET_DRAWS`` draws find no such place or the world has none),
+    at least ``spacing`` apart, each with the heading :func:`best_heading` chooses (a position where
+    none qualifies is drawn again); of ``TARGET_CANDIDATES`` such positions, the one whose heading
+    ranks first. The first ones do not depend on ``count``. A world too crowded for that (open
+    places taken first pack worse) is placed again with one position per target, first come
+    first served. ``ValueError`` when the world has no room for them all."""
     grid = grid or reachable_grid(world)
-    tries = [clearance, fallback] if fallback < clearance else [clearance]
-    if len(tries) > 1 and not has_room(grid, clearance):
-        tries = tries[1:]
-    failure = ValueError("no clearance to try")
-    for clear in tries:
-        try:
-            return _place(FreeFloor.of(world, clear, grid), count, seed, spacing=spacing, view_range=view_range,
-                          camera=camera)
-        except ValueError as exc:
-            failure = exc
-    raise failure
+    try:
+        return _place(world, count, seed, TARGET_CANDIDATES, clearance=clearance, fallback=fallback,
+                      spacing=spacing, view_range=view_range, camera=camera, grid=grid)
+    except ValueError:
+        if TARGET_CANDIDATES == 1:
+            raise
+    return _place(world, count, seed, 1, clearance=clearance, fallback=fallback, spacing=spacing,
+                  view_range=view_range, camera=camera, grid=grid)
 
 
-def _place(free: FreeFloor, count: int, seed: int, *, spacing: float, view_range: tuple[float, float],
-           camera: str) -> dict[str, Pose2D]:
-    """:func:`place_targets` at one clearance (``free``'s): per target, of ``TARGET_CANDIDATES``
-    positions drawn one after the other, the one whose best heading ranks first."""
-    azimuths = camera_rays(free.world, camera)
+def _place(world: World, count: int, seed: int, candidates: int, *, clearance: float, fallback: float,
+           spacing: float, view_range: tuple[float, float], camera: str, grid: FloorGrid) -> dict[str, Pose2D]:
+    """:func:`place_targets` keeping the best of ``candidates`` positions per target."""
+    levels = [clearance, fallback] if fallback < clearance else [clearance]
+    if len(levels) > 1 and not has_room(grid, clearance):
+        levels = levels[1:]
+    floors = [FreeFloor.of(world, c, grid) for c in levels]
+    azimuths = camera_rays(world, camera)
     rng = np.random.default_rng([seed, 0x60A3])
     placed: dict[str, Pose2D] = {}
 
     def judge(x: float, y: float) -> tuple[Pose2D, HeadingChoice] | None:
         if any(math.hypot(x - p.x, y - p.y) < spacing for p in placed.values()):
             return None
-        best = best_heading(free, x, y, azimuths, view_range=view_range, camera=camera)
+        best = best_heading(floors[0], x, y, azimuths, view_range=view_range, camera=camera)
         return None if best is None else (Pose2D(x, y, best.theta), best)
 
     for k in range(1, count + 1):
-        chosen = _best_of(free, rng, judge, TARGET_CANDIDATES)
+        chosen = _best_of(floors, rng, judge, candidates)
         if chosen is None:
-            raise ValueError(f"world {free.world.name!r} has room for {len(placed)} target(s), not {count}: "
-                             f"reachable, {free.clearance:g} m clear, {spacing:g} m apart, the {camera} camera "
-                             f"facing surfaces {view_range[0]:g}-{view_range[1]:g} m away")
+            raise ValueError(f"world {world.name!r} has room for {len(placed)} target(s), not {count}: reachable, "
+                             f"{levels[-1]:g} m clear, {spacing:g} m apart, the {camera} camera facing surfaces "
+                             f"{view_range[0]:g}-{view_range[1]:g} m away")
         placed[f"t{k}"] = chosen
     return placed
 
 
-def _best_of(free: FreeFloor, rng: np.random.Generator,
+def _best_of(floors: list[FreeFloor], rng: np.random.Generator,
              judge: Callable[[float, float], tuple[Pose2D, HeadingChoice] | None], tries: int) -> Pose2D | None:
-    """Of up to ``tries`` positions drawn one after the other (:meth:`FreeFloor.draw`), the pose whose
-    heading ranks first (:meth:`HeadingChoice.key`; the earlier one on a tie); None when the first
-    draw finds none (fewer when a later one finds none)."""
+    """Of up to ``tries`` positions drawn one after the other, the pose whose heading ranks first
+    (:meth:`HeadingChoice.key`; the earlier one on a tie). Positions are drawn from the strictest of
+    ``floors`` first (``TARGET_DRAWS`` draws), the next one when that finds none (the last one:
+    ``MAX_DRAWS``); once a position is found, a failed draw ends the search. None: no position."""
     drawn: list[tuple[Pose2D, HeadingChoice]] = []
-    for _ in range(tries):
-        found = free.draw(rng, judge)
-        if found is None:
+    level = 0
+    while len(drawn) < tries and level < len(floors):
+        found = floors[level].draw(rng, judge, TARGET_DRAWS if level < len(floors) - 1 else MAX_DRAWS)
+        if found is not None:
+            drawn.append(found)
+        elif drawn:
             break
-        drawn.append(found)
+        else:
+            level += 1
     return max(drawn, key=lambda d: d[1].key())[0] if drawn else None
