@@ -13,7 +13,31 @@ per named pose of the world, named after the pose::
 pose and extra named poses (targets anywhere). :func:`place_targets` places targets in a world's
 free space (for a world without enough named poses): free as :func:`random_starts` (both draw
 through :class:`FreeFloor`), apart, and facing surfaces in range (:func:`best_heading`, with the
-simulator's own ray casting). :class:`TrueTrajectory` reads where the robot truly
+simulator's own ray casting).
+
+Placed targets must be ones ``learn_targets``' search can find. A target image is matched from
+a scan taken near its heading (the 30-degree sector of ``maps/coverage.py``) and somewhere on its
+line of sight: nearer or farther, the same scene at another scale. A target in a nook looking
+into a corner is seen from a few cells of floor, and the search (which covers the floor evenly,
+not nooks first) may give up before it stands there: a measured lab run never matched such a
+target. So, without knowing the world:
+
+- **room around a target**: ``TARGET_CLEARANCE`` (0.7 m) from every wall, box and pillar rather
+  than the starts' 0.45 m; a target falls back to ``START_CLEARANCE`` when ``TARGET_DRAWS``
+  draws find no such place (the world has none, :func:`has_room`, or the targets before it
+  took it);
+- **a view seen from much floor**: of the qualifying headings (every ray 1-5 m, at least two
+  surfaces, as before), those whose optical axis meets its surface 2-4 m away
+  (``PREFERRED_CENTRE``: far enough for a long line of sight, near enough for detail) when any
+  does, then the one with the most reachable floor inside the camera's field of view between the
+  camera and the surfaces it sees (:func:`floor_in_view`, on the reachable floor grid: where the
+  robot can stand to see that view), then the most surfaces, then the axis nearest 3 m;
+- **an open position**: of ``TARGET_CANDIDATES`` (3) positions drawn one after the other, the
+  one whose chosen heading ranks first (so still anywhere in the room, but rarely in a nook).
+  Open places taken first pack worse: a world too crowded for N targets so (12 in the lab) is
+  placed again first come, first served.
+
+Everything is drawn from the seed alone. :class:`TrueTrajectory` reads where the robot truly
 was at a time from a report's ``ground_truth`` section (exact while it stood still, from the
 section's ``stops``; interpolated between the decimated trajectory's rows otherwise).
 """
