@@ -9,8 +9,10 @@ Episodes (all through the sweep runner, in the results folder), per seed:
    start (``--option targets=a,b,c`` chooses among them; at least 2), or ``t1``..``tN`` **placed**
    in the free space (``--option targets=N``, 2 to 12; the default, 4 of them, when the world has
    fewer than 2 usable named poses): drawn from the seed by
-   :func:`~missions.eval.roadmap_world.place_targets` (reachable, 0.45 m clear, 1.5 m apart, the
-   front camera facing at least two surfaces 1-5 m away on every ray across its view). Placed
+   :func:`~missions.eval.roadmap_world.place_targets` (reachable, 0.7 m clear when there is room,
+   else 0.45 m, 1.5 m apart, the front camera facing at least two surfaces 1-5 m away on every
+   ray across its view, preferring an axis 2-4 m long and the view with the most reachable floor
+   in it: one the search can find). Placed
    targets are added to a copy of the world file, ``seeds/<world>_s<seed>/<world>.yaml``, and that
    seed's snapshots, learn and goto episodes all run in the copy (self-contained, resumable).
 2. **Learn**: ``learn_targets`` from the world's start with that folder; it writes the roadmap to

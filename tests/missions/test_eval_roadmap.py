@@ -30,10 +30,17 @@ from missions.eval.roadmap import (
     summarise,
 )
 from missions.eval.roadmap_world import (
+    PREFERRED_CENTRE,
     START_CLEARANCE,
+    TARGET_CLEARANCE,
+    FreeFloor,
     TrueTrajectory,
+    best_heading,
     camera_rays,
     camera_view,
+    floor_in_view,
+    has_room,
+    heading_choices,
     place_targets,
     random_starts,
     reachable_grid,
@@ -65,6 +72,14 @@ BARE = re.sub(r"poses:\n(  .*\n)+", "", FURNISHED)  # no named poses
 CUPBOARD = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [1.6, 0], [1.6, 1.6], [0, 1.6]], closed: true, "
                   "height: 2.4}]\n", BARE)
 CUPBOARD = re.sub(r"(boxes|pillars): .*\n", "", CUPBOARD)
+# 8 x 1.2 m: nowhere 0.7 m clear, but room for targets 0.45 m clear looking along it
+GALLERY = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [8, 0], [8, 1.2], [0, 1.2]], closed: true, "
+                 "height: 2.4}]\n", BARE)
+GALLERY = re.sub(r"(boxes|pillars): .*\n", "", GALLERY).replace("{x: 0.8, y: 0.8,", "{x: 0.8, y: 0.6,")
+# 6 x 6 m, empty: the floor in view has a closed form
+EMPTY = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [6, 0], [6, 6], [0, 6]], closed: true, height: 2.4}]\n",
+               BARE)
+EMPTY = re.sub(r"(boxes|pillars): .*\n", "", EMPTY)
 
 
 def test_random_starts_are_clear_reachable_and_drawn_from_the_seed_alone(world_file):
@@ -105,8 +120,10 @@ def test_placed_targets_are_free_reachable_apart_and_face_surfaces_in_range(worl
     assert place_targets(world, 2, seed=3) == dict(list(targets.items())[:2])  # the first ones do not depend on N
     assert place_targets(world, 4, seed=4) != targets
     scene, grid, rays = Scene(world), reachable_grid(world), camera_rays(world)
+    # room around a target: the lab has it for all; in the furnished 6 x 4 m room the first ones take it
+    assert scene.clearance(targets["t1"].x, targets["t1"].y) >= TARGET_CLEARANCE
     for pose in targets.values():
-        assert scene.clearance(pose.x, pose.y) >= START_CLEARANCE
+        assert scene.clearance(pose.x, pose.y) >= (TARGET_CLEARANCE if name == "lab" else START_CLEARANCE)
         row, col, _ = grid.cells_of([pose.x, pose.y])
         assert grid.reachable[row[0], col[0]]
         assert 1.0 <= _centre_ray(world, scene, pose) <= 5.0
@@ -119,6 +136,57 @@ def test_placed_targets_are_free_reachable_apart_and_face_surfaces_in_range(worl
     xmin, _, xmax, _ = world.bounds()
     span = xmax - xmin
     assert min(p.x for p in spread) < xmin + 0.4 * span and max(p.x for p in spread) > xmax - 0.4 * span
+
+
+@pytest.mark.parametrize("name", ["bare", "lab"])
+def test_placed_targets_look_across_the_most_floor_the_robot_can_stand_on(world_file, name):
+    """The heading chosen at a target is the one whose view is seen from the largest reachable area
+    (among those whose optical axis meets its surface 2-4 m away, when any does), and the placed
+    targets' views hold far more floor than the worst qualifying heading at their positions."""
+    world = load_world(str(world_file(BARE)) if name == "bare" else "lab")
+    free, rays = FreeFloor.of(world, START_CLEARANCE), camera_rays(world)
+    chosen_floor, worst_floor = [], []
+    for seed in range(3):
+        for pose in place_targets(world, 4, seed).values():
+            choices = heading_choices(free, pose.x, pose.y, rays)
+            chosen = [c for c in choices if abs(math.remainder(c.theta - pose.theta, 2 * math.pi)) < 1e-9]
+            assert len(chosen) == 1  # a qualifying heading
+            preferred = [c for c in choices if PREFERRED_CENTRE[0] <= c.view.centre <= PREFERRED_CENTRE[1]]
+            assert chosen[0].floor == max(c.floor for c in (preferred or choices))
+            assert best_heading(free, pose.x, pose.y, rays) == chosen[0]
+            chosen_floor.append(chosen[0].floor)
+            worst_floor.append(min(c.floor for c in choices))
+    assert sum(chosen_floor) > 1.5 * sum(worst_floor)
+    assert min(chosen_floor) >= 1.0  # m^2: never a view of a nook seen from a few cells
+
+
+def test_floor_in_view_is_the_reachable_floor_between_the_camera_and_the_wall(world_file):
+    world = load_world(str(world_file(EMPTY)))
+    free, rays = FreeFloor.of(world, START_CLEARANCE), camera_rays(world)
+    pose = Pose2D(1.0, 3.0, 0.0)  # facing the east wall, 5 m ahead
+    where = camera_pose(world.camera("front"), world.ptu, pose)
+    view = camera_view(free.scene, world, pose, rays)
+    floor = floor_in_view(free.cells, free.grid.resolution**2, where.eye, where.psi, rays, view)
+    # a triangle from the eye to where the robot's centre can go (the robot's radius short of the wall)
+    depth = 6.0 - world.robot_radius - where.eye[0]
+    expected = 0.5 * depth**2 * (math.tan(rays.max()) + math.tan(-rays.min()))
+    assert floor == pytest.approx(expected, rel=0.05)
+    nearer = Pose2D(4.0, 3.0, 0.0)  # 2 m from the wall: the same view seen from less floor
+    there = camera_pose(world.camera("front"), world.ptu, nearer)
+    close = floor_in_view(free.cells, free.grid.resolution**2, there.eye, there.psi, rays,
+                          camera_view(free.scene, world, nearer, rays))
+    assert close == pytest.approx(0.5 * (6.0 - world.robot_radius - there.eye[0]) ** 2
+                                  * (math.tan(rays.max()) + math.tan(-rays.min())), rel=0.1)
+    assert close < 0.25 * floor
+
+
+def test_targets_fall_back_to_the_start_clearance_without_room(world_file):
+    world = load_world(str(world_file(GALLERY, "gallery.yaml")))
+    assert not has_room(reachable_grid(world), TARGET_CLEARANCE)
+    targets = place_targets(world, 2, seed=0)
+    scene = Scene(world)
+    assert all(START_CLEARANCE <= scene.clearance(p.x, p.y) < TARGET_CLEARANCE for p in targets.values())
+    assert has_room(reachable_grid(load_world("lab")), TARGET_CLEARANCE)
 
 
 def test_no_room_for_targets_is_said(world_file):
