@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -59,6 +59,7 @@ from drivers.sim.world import World, load_world
 from maps.ltmap import DEFAULT_MIN_LANDMARKS, LandmarkTree
 from maps.ltmap_file import load_ltmap
 from missions.eval import EvalOptions
+from missions.eval.figures import cell, mean_present
 from missions.eval.ltmap_route import Route, default_route, given_route, parse_route
 from missions.sweep import Episode, run_sweep
 from missions.sweep.table import REPORTS
@@ -274,11 +275,6 @@ def repeat_figures(teach: Mapping[str, Any], repeat: Mapping[str, Any] | None, l
     return out
 
 
-def _mean(values: Sequence[Any]) -> float | None:
-    present = [float(v) for v in values if v is not None]
-    return float(np.mean(present)) if present else None
-
-
 def row_figures(runs: list[dict[str, Any]]) -> dict[str, Any]:
     """One Table-I row: means over the seeds' repeats of one number of levels cut."""
     heights = sorted({r["height"] for r in runs})
@@ -289,18 +285,18 @@ def row_figures(runs: list[dict[str, Any]]) -> dict[str, Any]:
         "height": heights[0] if len(heights) == 1 else None,
         "height_range": [heights[0], heights[-1]],
         "seeds": len(runs),
-        "viewframes": _mean([r["viewframes"] for r in runs]),
-        "landmarks": _mean([r["landmarks"] for r in runs]),
-        "bytes": _mean([r["bytes"] for r in runs]),
-        "memory_pct": 100.0 * (_mean([r["memory_fraction"] for r in runs]) or 0.0),
-        "viewframe_error_m": _mean([r.get("viewframe_error_m") for r in good]),
-        "path_error_m": _mean([r.get("path_error_m") for r in good]),
-        "path_error_reached_m": _mean([r.get("path_error_m") for r in reached]),
-        "goal_error_m": _mean([r.get("goal_error_m") for r in good]),
+        "viewframes": mean_present([r["viewframes"] for r in runs]),
+        "landmarks": mean_present([r["landmarks"] for r in runs]),
+        "bytes": mean_present([r["bytes"] for r in runs]),
+        "memory_pct": 100.0 * (mean_present([r["memory_fraction"] for r in runs]) or 0.0),
+        "viewframe_error_m": mean_present([r.get("viewframe_error_m") for r in good]),
+        "path_error_m": mean_present([r.get("path_error_m") for r in good]),
+        "path_error_reached_m": mean_present([r.get("path_error_m") for r in reached]),
+        "goal_error_m": mean_present([r.get("goal_error_m") for r in good]),
         "goal_reached": len(reached),
-        "viewframes_reached_pct": 100.0 * (_mean([r.get("viewframes_reached") for r in good]) or 0.0),
-        "recoveries": _mean([r.get("recoveries") for r in good]),
-        "sim_time_s": _mean([r.get("sim_time_s") for r in good]),
+        "viewframes_reached_pct": 100.0 * (mean_present([r.get("viewframes_reached") for r in good]) or 0.0),
+        "recoveries": mean_present([r.get("recoveries") for r in good]),
+        "sim_time_s": mean_present([r.get("sim_time_s") for r in good]),
     }
     if len(good) < len(runs):
         row["errors"] = len(runs) - len(good)
@@ -383,17 +379,17 @@ def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dic
         "route_margin_m": settings.route.margin_m,
         "route": [round(v, 3) for v in settings.route.odometry],
         "route_world": np.round(settings.route.world_xy, 3).tolist(),
-        "goal_tolerance_m": _mean([t["goal_tolerance_m"] for t in teach_rows]),
+        "goal_tolerance_m": mean_present([t["goal_tolerance_m"] for t in teach_rows]),
         "criterion": (f"SUCCESS within {settings.goal_tolerance:g} m of the route's start"
                       if settings.goal_tolerance is not None else
                       "SUCCESS within the robot's diameter or the viewframe spacing (the larger; mean "
-                      f"{_cell(_mean([t['goal_tolerance_m'] for t in teach_rows]), 2)} m) of the route's start"),
+                      f"{cell(mean_present([t['goal_tolerance_m'] for t in teach_rows]), 2)} m) of the route's start"),
         "taught": len(teach_rows),
         "teach_failed": failed,
-        "teach.viewframes": _mean([t["viewframes"] for t in teach_rows]),
-        "teach.height": _mean([t["height"] for t in teach_rows]),
-        "teach.bytes": _mean([t["bytes"] for t in teach_rows]),
-        "teach.path_length_m": _mean([t["path_length_m"] for t in teach_rows]),
+        "teach.viewframes": mean_present([t["viewframes"] for t in teach_rows]),
+        "teach.height": mean_present([t["height"] for t in teach_rows]),
+        "teach.bytes": mean_present([t["bytes"] for t in teach_rows]),
+        "teach.path_length_m": mean_present([t["path_length_m"] for t in teach_rows]),
         "min_landmarks": sorted({t["min_landmarks"] for t in teach_rows}),
         "repeats": len(runs),
     }
@@ -424,14 +420,6 @@ def memory_limits(rows: list[dict[str, Any]]) -> dict[str, float | None]:
     return {"goal_reached_down_to_memory_pct": still, "goal_first_missed_memory_pct": lost}
 
 
-def _cell(value: Any, digits: int = 3) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float):
-        return f"{value:.{digits}f}"
-    return str(value)
-
-
 def format_table(figures: Mapping[str, Any]) -> str:
     """The rows as the paper's Table I, with the setting above them."""
     route = f"{figures['route_source']} of {figures['route_length_m']:.1f} m"
@@ -446,16 +434,16 @@ def format_table(figures: Mapping[str, Any]) -> str:
     for row in figures["rows"]:
         low, high = row["height_range"]
         height = str(low) if low == high else f"{low}-{high}"
-        path = f"{_cell(row['path_error_reached_m'])} ({_cell(row['path_error_m'])})"
-        lines.append(f"{height:>6} {row['levels_cut']:>3} {_cell(row['viewframes'], 1):>10} "
-                     f"{_cell(row['landmarks'], 0):>9} {_cell(row['memory_pct'], 1):>8} "
-                     f"{_cell(row['viewframe_error_m']):>8} {path:>16} {_cell(row['goal_error_m']):>10} "
-                     f"{_cell(row['viewframes_reached_pct'], 0):>12} {row['goal_reached']:>7} of {row['seeds']}"
+        path = f"{cell(row['path_error_reached_m'])} ({cell(row['path_error_m'])})"
+        lines.append(f"{height:>6} {row['levels_cut']:>3} {cell(row['viewframes'], 1):>10} "
+                     f"{cell(row['landmarks'], 0):>9} {cell(row['memory_pct'], 1):>8} "
+                     f"{cell(row['viewframe_error_m']):>8} {path:>16} {cell(row['goal_error_m']):>10} "
+                     f"{cell(row['viewframes_reached_pct'], 0):>12} {row['goal_reached']:>7} of {row['seeds']}"
                      + (f"  ({row['errors']} errors)" if row.get("errors") else ""))
     still, lost = figures.get("goal_reached_down_to_memory_pct"), figures.get("goal_first_missed_memory_pct")
     if figures["rows"]:
-        lines.append(f"goal reached by every seed down to {_cell(still, 1)} % memory; first missed at "
-                     f"{_cell(lost, 1)} %")
+        lines.append(f"goal reached by every seed down to {cell(still, 1)} % memory; first missed at "
+                     f"{cell(lost, 1)} %")
     for fail in figures["teach_failed"]:
         lines.append(f"seed {fail['seed']}: no map to repeat ({fail['problem']})")
     if figures.get("warning"):

@@ -55,6 +55,7 @@ import numpy as np
 
 from drivers.sim.world import World, load_world
 from missions.eval import EvalOptions
+from missions.eval.figures import cell, mean_present
 from missions.eval.roadmap_world import (
     TrueTrajectory,
     place_targets,
@@ -325,11 +326,6 @@ def goto_figures(plan: GotoPlan, report: Mapping[str, Any] | None, row: Mapping[
     return out
 
 
-def _mean(values: Sequence[Any]) -> float | None:
-    present = [float(v) for v in values if v is not None]
-    return float(np.mean(present)) if present else None
-
-
 def _worst(values: Sequence[Any]) -> float | None:
     present = [float(v) for v in values if v is not None]
     return max(present) if present else None
@@ -361,21 +357,21 @@ def summarise(world: str, settings: Settings, learns: list[dict[str, Any]], goto
         "targets.total": len(settings.targets) * len(learns),
         "targets.within": sum(run["within"] for run in learns),
         "targets.position_error_worst_m": _worst([e["position_m"] for e in errors]),
-        "targets.position_error_mean_m": _mean([e["position_m"] for e in errors]),
+        "targets.position_error_mean_m": mean_present([e["position_m"] for e in errors]),
         "targets.heading_error_worst_deg": _worst([e["heading_deg"] for e in errors]),
-        "targets.heading_error_mean_deg": _mean([e["heading_deg"] for e in errors]),
+        "targets.heading_error_mean_deg": mean_present([e["heading_deg"] for e in errors]),
         "graph.connected_rate": sum(run["connected"] for run in learns) / len(learns) if learns else None,
-        "graph.edges_mean": _mean([run["edges"] for run in learns]),
+        "graph.edges_mean": mean_present([run["edges"] for run in learns]),
         "goto.planned": settings.starts * len(learns),
         "goto.run": len(gotos),
         "goto.reached": reached,
         "goto.reached_rate": reached / len(gotos) if gotos else None,
         "goto.error_worst_m": _worst([g["error_m"] for g in measured]),
-        "goto.error_mean_m": _mean([g["error_m"] for g in measured]),
+        "goto.error_mean_m": mean_present([g["error_m"] for g in measured]),
         "goto.heading_error_worst_deg": _worst([g["error_deg"] for g in measured]),
-        "goto.heading_error_mean_deg": _mean([g["error_deg"] for g in measured]),
-        "learn.sim_time_s": _mean([run["sim_time_s"] for run in learns]),
-        "learn.wall_time_s": _mean([run["wall_time_s"] for run in learns]),
+        "goto.heading_error_mean_deg": mean_present([g["error_deg"] for g in measured]),
+        "learn.sim_time_s": mean_present([run["sim_time_s"] for run in learns]),
+        "learn.wall_time_s": mean_present([run["wall_time_s"] for run in learns]),
     }
     out["failures"] = [_failure(run) for run in [*learns, *gotos] if run["status"] != "SUCCESS"]
     out["runs"] = [*learns, *gotos]
@@ -431,16 +427,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
 # The table
 
 
-def _cell(value: Any, digits: int = 3) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float):
-        return f"{value:.{digits}f}"
-    return str(value)
-
-
 def _pair(metres: Any, degrees: Any) -> str:
-    return f"{_cell(metres)} m, {_cell(degrees, 2)} deg"
+    return f"{cell(metres)} m, {cell(degrees, 2)} deg"
 
 
 def format_table(figures: Mapping[str, Any]) -> str:
@@ -450,15 +438,15 @@ def format_table(figures: Mapping[str, Any]) -> str:
     lines = [
         f"roadmap in {f['world']}: {f['seeds']} seed(s), targets {', '.join(f['targets'])} "
         f"({f.get('targets.source', NAMED)}), {f['starts']} goto start(s) per seed; {f['criterion']}",
-        f"learn: {f['learn.succeeded']} of {f['seeds']} succeeded; sim {_cell(f['learn.sim_time_s'], 0)} s, wall "
-        f"{_cell(f['learn.wall_time_s'], 0)} s (means)",
+        f"learn: {f['learn.succeeded']} of {f['seeds']} succeeded; sim {cell(f['learn.sim_time_s'], 0)} s, wall "
+        f"{cell(f['learn.wall_time_s'], 0)} s (means)",
         f"targets found {f['targets.found']} of {f['targets.total']}, within {f['targets.within']}; error worst "
         f"{_pair(f['targets.position_error_worst_m'], f['targets.heading_error_worst_deg'])}, mean "
         f"{_pair(f['targets.position_error_mean_m'], f['targets.heading_error_mean_deg'])}",
-        f"graph connected {_cell(f['graph.connected_rate'], 2)} of the seeds, {_cell(f['graph.edges_mean'], 1)} "
+        f"graph connected {cell(f['graph.connected_rate'], 2)} of the seeds, {cell(f['graph.edges_mean'], 1)} "
         "edges (mean)",
         f"goto reached {f['goto.reached']} of {f['goto.run']} run ({f['goto.planned']} planned, rate "
-        f"{_cell(rate, 2)}); error worst {_pair(f['goto.error_worst_m'], f['goto.heading_error_worst_deg'])}, mean "
+        f"{cell(rate, 2)}); error worst {_pair(f['goto.error_worst_m'], f['goto.heading_error_worst_deg'])}, mean "
         f"{_pair(f['goto.error_mean_m'], f['goto.heading_error_mean_deg'])}",
         "",
         f"{'seed':>4} {'run':<18} {'status':<8} {'result':<38} {'error':<24} {'sim s':>7} {'wall s':>7}",
@@ -485,4 +473,4 @@ def _run_line(run: Mapping[str, Any]) -> str:
         result = "reached" if run["reached"] else "not reached"
         error = _pair(run["error_m"], run["error_deg"]) if run["error_m"] is not None else "-"
     return (f"{run['seed']:>4} {what:<18} {run['status']:<8} {result:<38} {error:<24} "
-            f"{_cell(run['sim_time_s'], 0):>7} {_cell(run['wall_time_s'], 0):>7}")
+            f"{cell(run['sim_time_s'], 0):>7} {cell(run['wall_time_s'], 0):>7}")
