@@ -122,13 +122,17 @@ class GotoPlan:
 
 
 def check_world(world: str) -> World:
-    """The world, loaded, with the cameras ``learn_targets`` reads. Its named poses do not matter
-    here: without 2 usable ones the targets are placed in the free space (``check_options``)."""
+    """The world, loaded, with the cameras ``learn_targets`` reads, and enclosed (an open world would
+    only fail in the room estimate, after placing targets for minutes). Its named poses do not
+    matter here: without 2 usable ones the targets are placed in the free space (``check_options``)."""
     loaded = load_world(world)
     kinds = {spec.name: spec.kind for spec in loaded.cameras}
     missing = [f"{name} ({kind})" for name, kind in CAMERAS.items() if kinds.get(name) != kind]
     if missing:
         raise ValueError(f"world {loaded.name!r} has no {' or '.join(missing)} camera: learn_targets needs them")
+    if not reachable_grid(loaded).bounded:
+        raise ValueError(f"world {loaded.name!r} is open (its reachable floor runs off the map): the roadmap's room "
+                         "estimate needs one enclosed room, seen all around from the dodecagon")
     return loaded
 
 

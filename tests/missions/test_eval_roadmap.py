@@ -381,6 +381,12 @@ def test_a_world_without_room_for_targets_exits_2(world_file, capsys):
     assert len(err.splitlines()) == 1 and "has room for" in err and "not 4" in err
 
 
+def test_an_open_world_exits_2_before_any_placement(capsys):
+    assert main(["eval", "roadmap", "--world", "outdoor"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "is open" in err and "enclosed room" in err
+
+
 def test_the_evaluation_in_the_small_room(world_file, tmp_path, capsys):
     """Target images, a learn run and a navigation from a random start, all through the sweep runner."""
     world, out = str(world_file(SMALL_ROOM, "small.yaml")), tmp_path / "eval"
