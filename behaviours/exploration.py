@@ -351,7 +351,6 @@ class SelectGoalPoint(BearingsBehaviour):
         self.selections = 0
         self.reached = 0
         self.abandoned = 0
-        self.verifications = 0
         self._logged: Goal | None = None  # the goal last logged to rerun
         self._recorded: Goal | None = None  # the goal last recorded in ``goals``
 
@@ -404,13 +403,17 @@ class SelectGoalPoint(BearingsBehaviour):
     def _verify(self, m: ExplorationMap, pose: Pose2D) -> bool:
         """No border is reachable: set a VERIFY goal if some border is closed only by cells worth
         looking at again (:func:`maps.exploration_goal.verification_goal`)."""
-        skip = self.avoid + self.given_up
-        goal = verification_goal(m, (pose.x, pose.y), self.params, avoid=np.array(skip) if skip else None,
+        goal = verification_goal(m, (pose.x, pose.y), self.params, avoid=self._avoided(),
                                  verified=np.array(self.verified) if self.verified else None)
         if goal is None:
             return False
         self._set_goal(goal)
         return True
+
+    def _avoided(self) -> np.ndarray | None:
+        """The targets whose border points are no candidates now (K x 2), None without any."""
+        targets = self.avoid + self.given_up
+        return np.array(targets) if targets else None
 
     def _avoid(self, target: tuple[float, float]) -> None:
         """Avoid a border point reached or abandoned: until its second chance, or for good after it."""
@@ -419,8 +422,8 @@ class SelectGoalPoint(BearingsBehaviour):
 
     def _select(self, m: ExplorationMap, pose: Pose2D, current: Goal | None) -> None:
         before = self.switch.mode
-        avoid = np.array(self.avoid + self.given_up) if self.avoid or self.given_up else None
-        self.switch, goal = select_goal(self.switch, m, (pose.x, pose.y), self.params, current=current, avoid=avoid)
+        self.switch, goal = select_goal(self.switch, m, (pose.x, pose.y), self.params, current=current,
+                                        avoid=self._avoided())
         self.selections += 1
         self.selected_at = self.now()
         now = round(self.now(), 2)
@@ -437,8 +440,6 @@ class SelectGoalPoint(BearingsBehaviour):
             self.goals.append([round(self.now(), 2), goal.mode.value, round(goal.target[0], 3),
                                round(goal.target[1], 3), goal.point, round(goal.distance, 3), round(goal.cost, 3),
                                None if math.isnan(goal.power) else round(goal.power, 3)])
-            if goal.mode is Mode.VERIFY:
-                self.verifications += 1
         self.goal = goal
         self.set_output("goal", goal)
 
@@ -458,7 +459,7 @@ class SelectGoalPoint(BearingsBehaviour):
             "selections": self.selections,
             "goals_reached": self.reached,
             "goals_abandoned": self.abandoned,
-            "verifications": self.verifications,
+            "verifications": sum(g[1] == Mode.VERIFY.value for g in self.goals),
             "goal_count": len(self.goals),
             "goals": self.goals,
             "goal_columns": "t, mode, x, y, point, d, G, A_P",

@@ -276,13 +276,12 @@ def verification_goal(
 
     For when no border is reachable: among the border points that a disc of ``verify_radius``
     reaches (none within ``avoid_radius`` of ``avoid``) and that are the nearest such border point
-    of some detected point lying more than ``k`` beyond (open space seen through the gap, as for
-    eq. 1; a gap between furniture and a wall with nothing beyond is not worth the trip), the
-    closest whose narrow path is closed
-    for the robot's own disc at a place (``blocked``: the first cell of the path it cannot pass)
-    not within ``look_back`` of one already ``verified`` (one look covers that much). The goal is the cell of that path
-    ``look_back`` metres before the place (or the last passable one, nearer). Driving there faces the
-    cells that closed the way; if they were stereo speckle or smear they clear (the evidence is
+    of some detected point lying more than ``k`` beyond (something seen through the gap, see
+    :func:`_promising`), the closest whose narrow path is closed for the robot's own disc at a
+    place (``blocked``: the first cell of the path it cannot pass) not within ``look_back`` of one
+    already ``verified`` (one look covers that much). The goal is the cell of that path
+    ``look_back`` metres before the place (or the last passable one, nearer). Driving there faces
+    the cells that closed the way; if they were stereo speckle or smear they clear (the evidence is
     log-odds) and the border becomes reachable; if they stay, the caller adds ``blocked`` to
     ``verified``. None: nothing to verify.
     A choice of ours (the paper ends at the first selection without a reachable border): in
