@@ -7,6 +7,7 @@ import contextlib
 import io
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -57,6 +58,15 @@ def run(*args: str) -> int:
         return main(list(args))
 
 
+def goto(world: Path, roadmap: Path, target: str, report: Path) -> dict:
+    """The report of a ``goto_target`` run that succeeded."""
+    code = run("run", "goto_target", "--sim", str(world), "--quiet", "--report", str(report),
+               "--set", f"roadmap={roadmap}", "--set", f"target={target}")
+    data = json.loads(report.read_text())
+    assert code == 0, data["reason"]
+    return data
+
+
 @pytest.mark.parametrize("mission", ["learn_targets", "goto_target"])
 def test_the_library_missions_validate(mission):
     assert run("validate", mission) == 0
@@ -74,11 +84,7 @@ def test_goto_target_reaches_the_goal_through_the_graph(tmp_path):
     roadmap.save(tmp_path / "lab.roadmap")
     assert (images / "window.png").is_file()
     world = world_with("lab", tmp_path / "lab.yaml", start=Pose2D(3.6, 1.6, math.radians(60)))
-    report = tmp_path / "goto.json"
-    code = run("run", "goto_target", "--sim", str(world), "--quiet", "--report", str(report),
-               "--set", f"roadmap={tmp_path / 'lab.roadmap'}", "--set", "target=centre")
-    data = json.loads(report.read_text())
-    assert code == 0, data["reason"]
+    data = goto(world, tmp_path / "lab.roadmap", "centre", tmp_path / "goto.json")
     navigation = data["roadmap"]["navigation"]
     assert navigation["reached"] and navigation["visited"] == ["window", "centre"]
     final = data["ground_truth"]["final_pose"]
@@ -117,11 +123,7 @@ def test_learn_targets_then_goto_target_in_a_small_room(tmp_path, world_file):
         assert distance < 0.15 and heading < 5.0, name
     assert Roadmap.load(roadmap).names == ("a", "b")
     start = world_with(world, tmp_path / "start.yaml", start=Pose2D(3.4, 2.9, math.radians(-150)))
-    report = tmp_path / "goto.json"
-    code = run("run", "goto_target", "--sim", str(start), "--quiet", "--report", str(report),
-               "--set", f"roadmap={roadmap}", "--set", "target=a")
-    data = json.loads(report.read_text())
-    assert code == 0, data["reason"]
+    data = goto(start, roadmap, "a", tmp_path / "goto.json")
     final = data["ground_truth"]["final_pose"]
     distance, heading = pose_error(Pose2D(final["x"], final["y"], final["theta"]), truth["a"])
     assert distance < 0.05 and heading < 2.0
