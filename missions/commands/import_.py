@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from maps.store import InputError, output_problem
-from missions.commands.common import emit, fail, print_input_error
+from maps.store import InputError
+from missions.commands.common import emit, print_input_error
 from missions.importer import import_btcpp
 
 DESCRIPTION = """Turn a BehaviorTree.CPP v4 XML file (as Groot2 saves it: several <BehaviorTree>s with
@@ -27,10 +27,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.output:
-        problem = output_problem(args.output)
-        if problem:
-            return fail("import", f"cannot write {args.output}: {problem}")
     try:
         text = import_btcpp(args.tree)
     except InputError as exc:

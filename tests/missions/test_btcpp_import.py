@@ -138,6 +138,10 @@ def test_bearings_import_exits_2_with_located_problems_and_writes_nothing(tmp_pa
     assert err[-1] == "2 problems found" and not output.exists()
     assert main(["import", str(tmp_path / "missing.xml")]) == 2
     assert main(["import", str(path), "-o", str(tmp_path / "no" / "such" / "folder.yaml")]) == 2
+    good = _write(tmp_path, _tree("<Stop/>"), name="good.xml")
+    capsys.readouterr()
+    assert main(["import", str(good), "-o", str(tmp_path / "no" / "such" / "folder.yaml")]) == 2
+    assert "cannot write" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(("body", "expected"), [
