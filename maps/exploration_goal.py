@@ -276,8 +276,8 @@ def verification_goal(
 
     For when no border is reachable: among the border points that a disc of ``verify_radius``
     reaches (none within ``avoid_radius`` of ``avoid``) and that are the nearest such border point
-    of some detected point lying more than ``k`` beyond (something seen through the gap, see
-    :func:`_promising`), the closest whose narrow path is closed for the robot's own disc at a
+    of some detected point in unknown space lying more than ``k`` beyond, seen ``min_sightings``
+    times (something seen through the gap), the closest whose narrow path is closed for the robot's own disc at a
     place (``blocked``: the first cell of the path it cannot pass) not within ``look_back`` of one
     already ``verified`` (one look covers that much). The goal is the cell of that path
     ``look_back`` metres before the place (or the last passable one, nearer). Driving there faces
@@ -290,10 +290,14 @@ def verification_goal(
     """
     if params.verify_radius <= 0.0 or params.verify_radius >= params.robot_radius:
         return None
-    narrow = candidates(m, robot, replace(params, robot_radius=params.verify_radius), avoid)
+    # points near obstacle cells count here (point_clearance 0): the walls of a room seen through a
+    # door are what says a room is there; an ineligible point has d = 0 and never passes d > k
+    narrow = candidates(m, robot, replace(params, robot_radius=params.verify_radius, point_clearance=0.0), avoid)
     passable = traversable(m, params.robot_radius)
     done = np.zeros((0, 2)) if verified is None else np.asarray(verified, dtype=np.float64).reshape(-1, 2)
-    promising = _promising(m, narrow.border, params)
+    promising = np.zeros(len(narrow.border), dtype=bool)  # the nearest border point of a point more than k beyond
+    if len(narrow.border):
+        promising[narrow.nearest[narrow.distance > params.k]] = True
     order = np.flatnonzero(promising)[np.argsort(narrow.border_cost[promising], kind="stable")][:MAX_VERIFY_TRIES]
     for b in order:
         path = narrow.travel.path_to((float(narrow.border[b, 0]), float(narrow.border[b, 1])))
@@ -311,21 +315,6 @@ def verification_goal(
         target = (float(path[stop, 0]), float(path[stop, 1]))
         return Goal(Mode.VERIFY, target, None, 0.0, float(arc[stop]), math.nan, path[: stop + 1], blocked)
     return None
-
-
-def _promising(m: ExplorationMap, border: np.ndarray, params: GoalParams) -> np.ndarray:
-    """Border points (bool, B) that are the nearest of some detected point in unknown space more
-    than ``k`` beyond them and seen ``min_sightings`` times (unlike eq. 1's candidates, points near
-    obstacle cells count: the walls of a room seen through a door are what says a room is there)."""
-    promising = np.zeros(len(border), dtype=bool)
-    if len(border) == 0 or len(m.points) == 0:
-        return promising
-    seen = (m.cell_state(m.points[:, :2]) == Cell.UNKNOWN) & (m.sightings >= params.min_sightings)
-    if not seen.any():
-        return promising
-    distance, nearest = cKDTree(border).query(m.points[seen, :2])
-    promising[nearest[distance > params.k]] = True
-    return promising
 
 
 MAX_VERIFY_TRIES = 200  # border points tried per verification (closest first)

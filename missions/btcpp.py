@@ -35,7 +35,7 @@ import sys
 from dataclasses import dataclass
 from typing import Any
 
-from behaviours.ports import KEY_PATTERN, Key, Ref, key_problem, type_name
+from behaviours.ports import Key, Ref, key_problem, type_name
 
 _SIMPLE_PART = re.compile(r"[A-Za-z0-9]+(?:_[A-Za-z0-9]+)*")
 _HEX_PREFIX = "_"
@@ -65,7 +65,7 @@ def identifier_to_key(identifier: str) -> str | None:
     else:
         path, *attributes = body.split("___")
         key = "/" + path.replace("__", "/") + "".join("." + attribute for attribute in attributes)
-    if not KEY_PATTERN.match(key) or key_problem(key) or key_to_identifier(key) != "@" + body:
+    if key_problem(key) or key_to_identifier(key) != "@" + body:
         return None
     return key
 
@@ -118,7 +118,7 @@ def reads_as_double(value: float) -> bool:
 
 _INT = re.compile(r"[+-]?\d+")
 _FLOAT = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
-_TRUE, _FALSE = ("true", "True", "TRUE", "1"), ("false", "False", "FALSE", "0")
+TRUE_TEXT, _FALSE = ("true", "True", "TRUE", "1"), ("false", "False", "FALSE", "0")  # BT.CPP's booleans
 
 
 def parse_value(text: str, tp: Any) -> Any:
@@ -126,7 +126,7 @@ def parse_value(text: str, tp: Any) -> Any:
     (the mission loader then reports it against the port's declaration)."""
     stripped = text.strip()
     if tp is bool:
-        return True if stripped in _TRUE else False if stripped in _FALSE else text
+        return True if stripped in TRUE_TEXT else False if stripped in _FALSE else text
     if tp is int:
         return int(stripped) if _INT.fullmatch(stripped) else text
     if tp is float:

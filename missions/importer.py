@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any
 from xml.parsers import expat
 
-from behaviours.ports import KEY_PATTERN, REQUIRED, InputPort, OutputPort, Ref, key_problem, parse_ref
+from behaviours.ports import REQUIRED, InputPort, OutputPort, Ref, key_problem, parse_ref
 from behaviours.registry import NodeType, Registry
 from maps.located import suggest
 from maps.store import (
@@ -49,6 +49,7 @@ from missions.btcpp import (
     NO_EQUIVALENT,
     PRE_POST_CONDITIONS,
     SENSE_SUFFIX,
+    TRUE_TEXT,
     Comparison,
     blackboard_pointer,
     identifier_to_key,
@@ -162,7 +163,7 @@ def _key_of(name: str) -> str | None:
     """The bearings key of an identifier (``@robot__odometry``) or a key written as it is."""
     body = name.removeprefix("@")
     if body.startswith("/"):
-        return body if KEY_PATTERN.match(body) and key_problem(body) is None else None
+        return body if key_problem(body) is None else None
     return identifier_to_key(body)
 
 
@@ -210,9 +211,10 @@ class _Importer:
         return MissionDraft(main, tree, sense)
 
     def _contents(self, root: XmlElement) -> None:
+        single = sum(e.tag == "BehaviorTree" for e in root.children) == 1
         for element in root.children:
             if element.tag == "BehaviorTree":
-                self._behavior_tree(element, single=sum(e.tag == "BehaviorTree" for e in root.children) == 1)
+                self._behavior_tree(element, single=single)
             elif element.tag == "TreeNodesModel":
                 self._model(element)
             elif element.tag == "include":
@@ -355,7 +357,7 @@ class _Importer:
 
     def _subtree_scope(self, element: XmlElement, tree_id: str, scope: _Scope) -> _Scope | None:
         """The remapping of one SubTree instance: its attributes, then its model's defaults."""
-        autoremap = element.attrs.get("_autoremap", "false").strip() in ("true", "True", "TRUE", "1")
+        autoremap = element.attrs.get("_autoremap", "false").strip() in TRUE_TEXT
         given = {name: text for name, text in element.attrs.items() if self._is_port(element, name)}
         for port, default in self.subtree_models.get(tree_id, {}).items():
             if port in given or autoremap:

@@ -35,6 +35,7 @@ from behaviours.motion import ODOMETRY
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import RoadmapDisplay
+from behaviours.roadmap.routine import ROBOT_RADIUS
 from behaviours.roadmap.values import ScanRecord
 from maps.coverage import FRAGMENT_COST, CoverageGrid, choose_next, coverage_grid, reachable_positions
 from maps.room import RoomEstimate
@@ -54,8 +55,7 @@ class CoverageScoring(BearingsBehaviour):
     PORTS = (
         InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate"),
         InputPort("scan", ScanRecord, Ref("/map/scan"), doc="the images of the last scan (none yet: nothing)"),
-        InputPort("robot_radius", float, 0.28, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
-                  doc="radius of the disc the robot occupies (with a margin)"),
+        ROBOT_RADIUS,
         InputPort("min_new", int, 100, minimum=1, literal_only=True,
                   doc="fewest newly covered configurations that make a position worth a visit"),
         InputPort("fragment_cost", float, FRAGMENT_COST, minimum=0.0, literal_only=True,

@@ -66,7 +66,7 @@ import numpy as np
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import RoadmapDisplay, roadmap_section
-from behaviours.roadmap.homing import HOMING_PORTS, HomingSettings, home
+from behaviours.roadmap.homing import REQUIRED_ROOM, HomingSettings, home
 from behaviours.roadmap.paths import reanchored, travel
 from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.targets import relative_images
@@ -131,8 +131,7 @@ class BuildGraph(RoutineBehaviour):
         InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the target images"),
         InputPort("reference", TargetView, Ref("/map/reference_image"), doc="the image taken at the reference"),
         InputPort("file", str, "", doc="where to save the roadmap ('' : do not save)"),
-        *(p for p in HOMING_PORTS if p.name != "room"),
-        InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate"),
+        *REQUIRED_ROOM,
         *PLAN_PORTS,
         *ROUTINE_PORTS,
         OutputPort("roadmap_out", Roadmap, "/map/roadmap", doc="the roadmap with its edges"),

@@ -55,6 +55,7 @@ from behaviours.roadmap.paths import travel
 from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.values import HomingResult, TargetImages, TargetView
 from behaviours.roadmap.vision import (
+    MIN_INLIERS,
     Comparison,
     camera_pose,
     compare_frame,
@@ -79,10 +80,14 @@ HOMING_PORTS = (
               doc="homing ends after driving to an estimate measured from closer than this"),
     InputPort("max_rounds", int, 5, minimum=1, maximum=20, literal_only=True,
               doc="triangulation rounds before homing gives up"),
-    InputPort("min_inliers", int, 25, minimum=8, maximum=10000, literal_only=True,
+    InputPort("min_inliers", int, MIN_INLIERS, minimum=8, maximum=10000, literal_only=True,
               doc="correspondences agreeing on one planar motion for a match"),
     InputPort("room", RoomEstimate, None, doc="room estimate (optional): sidestep towards free floor first"),
     ROBOT_RADIUS,
+)
+REQUIRED_ROOM = (  # the homing ports of a node that cannot work without the room estimate
+    *(p for p in HOMING_PORTS if p.name != "room"),
+    InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate"),
 )
 
 

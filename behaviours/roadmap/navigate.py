@@ -68,7 +68,7 @@ class NavigateToTarget(RoutineBehaviour):
         if len(low_high) != 2 or not 0 <= low_high[0] <= low_high[1]:
             raise ValueError(f"NavigateToTarget.random_distance takes [shortest, longest], got {low_high}")
         self.result: NavigationResult | None = None
-        self.rng = np.random.default_rng(0)
+        self.rng = np.random.default_rng(0)  # re-seeded from the seed port when the routine starts
         self.display = RoadmapDisplay()
 
     def routine(self) -> Step[None]:

@@ -16,7 +16,7 @@ from typing import Any
 from behaviours.ports import InputPort, OutputPort, Port, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import RoadmapDisplay
-from behaviours.roadmap.homing import HOMING_PORTS, HomingSettings, home
+from behaviours.roadmap.homing import REQUIRED_ROOM, HomingSettings, home
 from behaviours.roadmap.paths import PLAN_TIME, reanchored, travel
 from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.values import TargetView
@@ -70,8 +70,7 @@ class ReturnToReference(RoutineBehaviour):
 
     PORTS = (
         InputPort("reference", TargetView, Ref("/map/reference_image"), doc="the image taken at the reference"),
-        *(p for p in HOMING_PORTS if p.name != "room"),
-        InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate"),
+        *REQUIRED_ROOM,
         *PLAN_PORTS,
         *ROUTINE_PORTS,
         OutputPort("room_out", RoomEstimate, "/map/room", doc="the room, re-anchored at the homed reference pose"),
