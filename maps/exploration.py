@@ -81,7 +81,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from perception.camera import PinholeCamera, StereoRig
-from perception.geometry import Pose2D, wrap_angles
+from perception.geometry import Pose2D, rot_pitch, rot_z, wrap_angles
 
 _SHIFT = 4  # sub-cell precision (bits) of the scan's wedges drawn by cv2.fillConvexPoly
 _CROSS = ndimage.generate_binary_structure(2, 1)
@@ -315,17 +315,6 @@ class CameraView:
     heading: float
 
 
-def _rot_z(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def _rot_pitch(pitch: float) -> np.ndarray:
-    """Lifts the x axis by ``pitch`` (positive looks up), as the simulator's pan-tilt head does."""
-    c, s = math.cos(pitch), math.sin(pitch)
-    return np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
-
-
 def vertical_fov(camera: PinholeCamera) -> float:
     """Angle (rad) between the top and bottom edges of the image along its centre column."""
     edges = camera.pixel_to_bearing(np.array([[camera.cx, -0.5], [camera.cx, camera.height - 0.5]]))
@@ -365,7 +354,7 @@ class StereoHead:
 
     def view(self, robot: Pose2D, pan: float, tilt: float) -> CameraView:
         """The left camera when the base is at ``robot`` (odometry) and the head at (pan, tilt)."""
-        rotation = _rot_z(robot.theta + pan) @ _rot_pitch(tilt)
+        rotation = rot_z(robot.theta + pan) @ rot_pitch(tilt)
         head = np.array([*self.axis_xy(robot), self.ptu[2]])
         eye = head + rotation @ np.asarray(self.camera, dtype=np.float64)
         return CameraView(eye, rotation, self.vertical_fov, self.horizontal_fov, robot.theta)

@@ -13,6 +13,19 @@ from dataclasses import dataclass
 import numpy as np
 
 
+def rot_z(angle: float) -> np.ndarray:
+    """Rotation about the vertical axis by ``angle`` rad (REP-103: x forward, y left, z up)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rot_pitch(pitch: float) -> np.ndarray:
+    """Rotation that lifts the x axis by ``pitch`` rad (about y by ``-pitch``; positive looks up):
+    a pan-tilt head's tilt."""
+    c, s = math.cos(pitch), math.sin(pitch)
+    return np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
+
+
 def wrap_angle(angle: float) -> float:
     """Wrap an angle to [-pi, pi)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi

@@ -22,18 +22,7 @@ from drivers.sim.sensors import BearingSensorModel, observe_landmarks
 from drivers.sim.world import CameraSpec, Lighting, PtuSpec
 from perception.camera import StereoRig
 from perception.frame import Frame, LandmarkBearings
-from perception.geometry import Pose2D
-
-
-def rot_z(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def rot_pitch(pitch: float) -> np.ndarray:
-    """Rotation that lifts the x axis by ``pitch`` rad (about y by ``-pitch``, REP-103 axes)."""
-    c, s = math.cos(pitch), math.sin(pitch)
-    return np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
+from perception.geometry import Pose2D, rot_pitch, rot_z
 
 
 @dataclass(frozen=True, slots=True)
