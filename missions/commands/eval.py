@@ -14,16 +14,15 @@ import importlib
 import json
 import sys
 import tempfile
-from collections.abc import Iterator
-from concurrent.futures import Executor
 from pathlib import Path
 from typing import Any
 
 from maps.store import InputError
 from missions.commands.common import EXIT_FAILURE, EXIT_OK, fail, print_input_error
 from missions.eval import AREAS, EvalOptions
-from missions.sweep import SweepError, SweepInputError, SweepInterrupted, cluster_executor, local_executor
+from missions.sweep import SweepError, SweepInputError, SweepInterrupted, executor_for
 from missions.sweep.sweeper import progress_stream
+from missions.sweep.table import TABLE
 
 MAX_SEEDS = 10_000
 
@@ -55,19 +54,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-@contextlib.contextmanager
-def _executor(args: argparse.Namespace) -> Iterator[Executor]:
-    if args.cluster:
-        with cluster_executor(args.cluster) as executor:
-            yield executor
-    else:
-        executor = local_executor(args.workers)
-        try:
-            yield executor
-        finally:
-            executor.shutdown(wait=True, cancel_futures=True)
-
-
 def _problem(args: argparse.Namespace) -> str | None:
     if not 1 <= args.seeds <= MAX_SEEDS:
         return f"--seeds must be 1 to {MAX_SEEDS}, got {args.seeds}"
@@ -79,7 +65,7 @@ def _problem(args: argparse.Namespace) -> str | None:
             return f"--{name.replace('_', '-')} must be positive, got {value:g}"
     if args.resume and args.output is None:
         return "--resume needs -o DIR"
-    if args.output is not None and not args.resume and (args.output / "results.jsonl").exists():
+    if args.output is not None and not args.resume and (args.output / TABLE).exists():
         return f"{args.output} already has results: --resume continues them, or choose another folder"
     return None
 
@@ -119,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
     with contextlib.ExitStack() as stack:
         folder = args.output or Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="bearings-eval-")))
         try:
-            executor = stack.enter_context(_executor(args))
+            executor = stack.enter_context(executor_for(args.workers, args.cluster))
             options = EvalOptions(args.world, list(range(args.seeds)), executor, folder, args.timeout,
                                   args.max_time, progress_stream(args.progress), extra)
             figures = module.run(options, resume=args.resume)

@@ -9,7 +9,6 @@ import signal
 import sys
 import warnings
 from collections.abc import Iterator
-from concurrent.futures import Executor
 from pathlib import Path
 
 from maps.store import write_json
@@ -20,9 +19,8 @@ from missions.sweep.sweeper import (
     SweepError,
     SweepInterrupted,
     check_episodes,
-    cluster_executor,
     default_workers,
-    local_executor,
+    executor_for,
     progress_stream,
     run_sweep,
 )
@@ -98,7 +96,7 @@ def _run(args: argparse.Namespace) -> int:
         return _show(args.summary, args)
     try:
         episodes = _episodes(args)
-        with _executor(args) as executor:
+        with executor_for(args.workers, args.cluster) as executor:
             check_episodes(episodes, executor, start_method=args.start_method)
             with _sigterm_as_interrupt():
                 run_sweep(episodes, executor=executor, results_dir=args.output, timeout_s=args.timeout,
@@ -139,27 +137,6 @@ def _episodes(args: argparse.Namespace) -> list[spec.Episode]:
     seeds = spec.parse_seeds(args.seeds)
     sets = spec.parse_sets(args.sets)
     return spec.grid(mission, worlds, seeds, sets, max_time_s=args.max_time)
-
-
-class _NoCluster(spec.SweepInputError):
-    """--cluster cannot be used (no distributed package, or no scheduler there)."""
-
-
-@contextlib.contextmanager
-def _executor(args: argparse.Namespace) -> Iterator[Executor]:
-    if args.cluster is None:
-        with local_executor(args.workers) as pool:
-            yield pool
-        return
-    stack = contextlib.ExitStack()
-    try:
-        executor = stack.enter_context(cluster_executor(args.cluster))
-    except ImportError:
-        raise _NoCluster("--cluster needs Dask's distributed package: pip install 'bearings[cluster]'") from None
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise _NoCluster(f"cannot reach the Dask scheduler at {args.cluster}: {exc}") from None
-    with stack:
-        yield executor
 
 
 @contextlib.contextmanager

@@ -16,6 +16,7 @@ from missions.sweep.sweeper import (
     SweepInterrupted,
     cluster_executor,
     default_workers,
+    executor_for,
     local_executor,
     run_sweep,
 )
@@ -28,6 +29,7 @@ __all__ = [
     "SweepInputError",
     "SweepInterrupted",
     "cluster_executor",
+    "executor_for",
     "comparable",
     "default_workers",
     "format_summary",

@@ -93,6 +93,29 @@ def cluster_executor(address: str, *, connect_timeout_s: float | None = None) ->
         client.close()
 
 
+@contextlib.contextmanager
+def executor_for(workers: int | None, cluster: str | None) -> Iterator[Executor]:
+    """The executor a command's ``--workers``/``--cluster`` ask for: a local process pool (its
+    pending episodes cancelled on the way out) or a Dask scheduler. :class:`SweepInputError` with
+    the one-line reason when the cluster cannot be used (no distributed package, no scheduler)."""
+    if cluster is None:
+        pool = local_executor(workers)
+        try:
+            yield pool
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+        return
+    stack = contextlib.ExitStack()
+    try:
+        executor = stack.enter_context(cluster_executor(cluster))
+    except ImportError:
+        raise SweepInputError("--cluster needs Dask's distributed package: pip install 'bearings[cluster]'") from None
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise SweepInputError(f"cannot reach the Dask scheduler at {cluster}: {exc}") from None
+    with stack:
+        yield executor
+
+
 def run_sweep(
     episodes: Sequence[Episode],
     *,

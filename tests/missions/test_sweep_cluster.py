@@ -28,3 +28,10 @@ def test_unreachable_scheduler_is_invalid_input(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr("missions.sweep.sweeper.CONNECT_TIMEOUT_S", 0.5)
     assert main(["sweep", "square", "--cluster", "tcp://127.0.0.1:9", "-o", str(tmp_path)]) == 2
     assert "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in capsys.readouterr().err
+
+
+def test_eval_says_an_unreachable_scheduler_in_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr("missions.sweep.sweeper.CONNECT_TIMEOUT_S", 0.5)
+    assert main(["eval", "exploration", "--world", "lab", "--cluster", "tcp://127.0.0.1:9", "-o", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in err and "Traceback" not in err
