@@ -30,10 +30,8 @@ the two others'.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
 import cv2
@@ -45,7 +43,7 @@ from drivers.sim.world import load_world
 from maps.exploration import GridFrame, StereoHead, scan_cells
 from missions.eval import EvalOptions
 from missions.sweep import Episode, run_sweep
-from missions.sweep.table import REPORTS
+from missions.sweep.table import read_report
 from perception.geometry import Pose2D
 
 DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed"
@@ -256,8 +254,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     by_variant: dict[str, list[dict[str, Any]]] = {name: [] for name in VARIANTS}
     runs = []
     for row in rows:
-        path = Path(options.results_dir) / REPORTS / f"{row['id']}.json"
-        report = json.loads(path.read_text()) if path.exists() else None
+        report = read_report(options.results_dir, row["id"])
         variant = variant_of({k[len("inputs."):]: v for k, v in row.items() if k.startswith("inputs.")})
         figures = episode_figures(report, floor, world.robot_radius)
         by_variant[variant].append(figures)

@@ -45,7 +45,6 @@ unless seeds taught trees of different heights, then the range) holds the means 
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -62,7 +61,7 @@ from missions.eval import EvalOptions
 from missions.eval.figures import cell, mean_present
 from missions.eval.ltmap_route import Route, default_route, given_route, parse_route
 from missions.sweep import Episode, run_sweep
-from missions.sweep.table import REPORTS
+from missions.sweep.table import read_report
 
 DESCRIPTION = "teach and repeat: viewframe and path error, goal reached per LT-map tree height (Table I)"
 OPTIONS = {
@@ -204,11 +203,6 @@ def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_
     return Episode(FOLLOW, teach.world, teach.seed, inputs, max_time_s, start)
 
 
-def _report(folder: Path, episode: Episode) -> dict[str, Any] | None:
-    path = folder / REPORTS / f"{episode.id}.json"
-    return json.loads(path.read_text()) if path.exists() else None
-
-
 # ------------------------------------------------------------------------------------------------
 # Figures
 
@@ -314,7 +308,7 @@ def _teach_phase(options: EvalOptions, settings: Settings, folder: Path,
                 for seed in options.seeds}
     run_sweep(list(episodes.values()), executor=options.executor, results_dir=folder, timeout_s=options.timeout_s,
               progress=options.progress, resume=resume)
-    return {seed: (episode, _report(folder, episode)) for seed, episode in episodes.items()}
+    return {seed: (episode, read_report(folder, episode.id)) for seed, episode in episodes.items()}
 
 
 def _taught(teach: Episode, report: dict[str, Any] | None) -> LandmarkTree | str:
@@ -357,7 +351,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
                   timeout_s=options.timeout_s, progress=options.progress, resume=True)
     runs = []
     for episode, teach_report, level in plan:
-        figures = repeat_figures(teach_report, _report(folder, episode), level, tolerance[episode.seed])
+        figures = repeat_figures(teach_report, read_report(folder, episode.id), level, tolerance[episode.seed])
         runs.append({"seed": episode.seed, **figures})
     return summarise(world, settings, len(options.seeds), teach_rows, failed, runs)
 

@@ -44,7 +44,6 @@ learn episodes and read by the goto episodes: on a Dask cluster the results fold
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -53,6 +52,7 @@ from typing import Any
 
 import numpy as np
 
+from drivers.sim.floor import FloorGrid
 from drivers.sim.world import World, load_world
 from missions.eval import EvalOptions
 from missions.eval.figures import cell, mean_present
@@ -70,7 +70,7 @@ from missions.eval.roadmap_world import (
 )
 from missions.sweep import Episode, run_sweep
 from missions.sweep.episode import SweepInputError, absolute_if_file
-from missions.sweep.table import REPORTS
+from missions.sweep.table import read_report
 from perception.geometry import Pose2D
 
 DEFAULT_STARTS, MAX_STARTS = 5, 1000
@@ -214,7 +214,8 @@ def seed_folder(folder: Path, world: str, seed: int) -> Path:
     return folder / SEEDS / f"{Path(world).stem}_s{seed:04d}"
 
 
-def seed_targets(world: str, loaded: World, settings: Settings, seed: int, folder: Path) -> SeedTargets:
+def seed_targets(world: str, loaded: World, settings: Settings, seed: int, folder: Path,
+                 grid: FloorGrid | None = None) -> SeedTargets:
     """The seed's targets. Named poses: the world as it is. Placed: ``place_targets`` from the seed,
     written as named poses into a copy of the world file in the seed's folder (same file name, so
     the world keeps its name and the episodes' ids their world part); ``SweepInputError`` when the
@@ -222,7 +223,7 @@ def seed_targets(world: str, loaded: World, settings: Settings, seed: int, folde
     if settings.source == NAMED:
         return SeedTargets(world, {name: loaded.poses[name] for name in settings.targets})
     try:
-        poses = place_targets(loaded, len(settings.targets), seed)
+        poses = place_targets(loaded, len(settings.targets), seed, grid=grid)
     except ValueError as exc:
         raise SweepInputError(f"seed {seed}: {exc}") from None
     here = seed_folder(folder, world, seed)
@@ -239,10 +240,10 @@ def learn_episode(world: str, seed: int, folder: Path, max_time_s: float | None)
 
 
 def goto_plans(learn: Episode, world: World, found: Sequence[str], starts: int,
-               max_time_s: float | None) -> list[GotoPlan]:
+               max_time_s: float | None, grid: FloorGrid | None = None) -> list[GotoPlan]:
     """The seed's navigations: random starts (``random_starts``), goals drawn among ``found``; the
     mission's own ``seed`` (its random moves) is the navigation's number."""
-    poses = random_starts(world, starts, learn.seed)
+    poses = random_starts(world, starts, learn.seed, grid=grid)
     rng = np.random.default_rng([learn.seed, 0x60A2])
     goals = [found[int(i)] for i in rng.integers(len(found), size=starts)] if found else []
     plans = []
@@ -251,16 +252,6 @@ def goto_plans(learn: Episode, world: World, found: Sequence[str], starts: int,
         inputs = {"roadmap": learn.inputs["roadmap"], "target": goal, "seed": k}
         plans.append(GotoPlan(Episode(GOTO, learn.world, learn.seed, inputs, max_time_s, where), start, goal))
     return plans
-
-
-def _report(folder: Path, episode: Episode) -> dict[str, Any] | None:
-    """The episode's run report; None when it gave none (or an unreadable one: the run is an ERROR)."""
-    path = folder / REPORTS / f"{episode.id}.json"
-    try:
-        report = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-    return report if isinstance(report, dict) else None
 
 
 def _outcome(report: Mapping[str, Any] | None, row: Mapping[str, Any] | None) -> dict[str, Any]:
@@ -407,22 +398,23 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     settings = check_options(options.world, options.extra)
     world = absolute_if_file(options.world)  # episodes run in other processes
     folder = Path(options.results_dir).resolve()
-    targets = {seed: seed_targets(world, loaded, settings, seed, folder) for seed in options.seeds}
+    grid = reachable_grid(loaded)  # once: every seed's placed targets and random starts
+    targets = {seed: seed_targets(world, loaded, settings, seed, folder, grid) for seed in options.seeds}
     truth = {seed: t.poses for seed, t in targets.items()}
     episodes, rows = _learn_phase(options, targets, settings, folder, resume)
     learns, plans = [], []
     for seed, episode in sorted(episodes.items()):
-        figures = learn_figures(seed, _report(folder, episode), rows.get(episode.id), truth[seed])
+        figures = learn_figures(seed, read_report(folder, episode.id), rows.get(episode.id), truth[seed])
         learns.append(figures)
         found = sorted(figures["target_errors"])
         if settings.starts and found and Path(episode.inputs["roadmap"]).is_file():
-            plans += goto_plans(episode, loaded, found, settings.starts, options.max_time_s)
+            plans += goto_plans(episode, loaded, found, settings.starts, options.max_time_s, grid)
     rows = {}
     if plans:  # every navigation at once: the pool runs them in parallel
         done = run_sweep([p.episode for p in plans], executor=options.executor, results_dir=folder,
                          timeout_s=options.timeout_s, progress=options.progress, resume=True)
         rows = {row["id"]: row for row in done}
-    gotos = [goto_figures(p, _report(folder, p.episode), rows.get(p.episode.id), truth[p.episode.seed][p.goal])
+    gotos = [goto_figures(p, read_report(folder, p.episode.id), rows.get(p.episode.id), truth[p.episode.seed][p.goal])
              for p in plans]
     return summarise(loaded.name, settings, learns, gotos, truth)
 

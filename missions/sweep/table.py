@@ -176,6 +176,16 @@ def write_sorted(path: Path, rows: Iterable[dict[str, Any]]) -> None:
     write_text_atomic(path, "".join(lines))
 
 
+def read_report(results_dir: str | os.PathLike, episode_id: str) -> dict[str, Any] | None:
+    """The run report an episode left in a results folder; None when it left none, or an
+    unreadable one (its row says why: the run is an ERROR)."""
+    try:
+        report = json.loads((Path(results_dir) / REPORTS / f"{episode_id}.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return report if isinstance(report, dict) else None
+
+
 def load_table(results_dir: str | os.PathLike) -> list[dict[str, Any]]:
     """The rows of a results folder, one per episode, sorted by episode id."""
     return list(latest_by_id(read_rows(Path(results_dir) / TABLE)).values())

@@ -19,7 +19,6 @@ from missions.eval.roadmap import (
     PLACED,
     GotoPlan,
     Settings,
-    _report,
     check_options,
     check_world,
     format_table,
@@ -47,6 +46,7 @@ from missions.eval.roadmap_world import (
     usable_poses,
 )
 from missions.sweep import Episode
+from missions.sweep.table import read_report
 from perception.geometry import Pose2D
 from tests.missions.test_roadmap_missions import SMALL_ROOM
 
@@ -410,6 +410,6 @@ def test_a_torn_report_is_a_run_without_one(tmp_path):
     episode = Episode("learn_targets", "lab", 0, {"targets": "t", "roadmap": "r"})
     (tmp_path / "reports").mkdir()
     (tmp_path / "reports" / f"{episode.id}.json").write_text('{"status": "SUCC')  # a writer killed mid-write
-    assert _report(tmp_path, episode) is None
+    assert read_report(tmp_path, episode.id) is None
     row = {"status": "ERROR", "reason": "killed by SIGKILL"}
-    assert learn_figures(0, _report(tmp_path, episode), row, {})["reason"] == "killed by SIGKILL"
+    assert learn_figures(0, read_report(tmp_path, episode.id), row, {})["reason"] == "killed by SIGKILL"
