@@ -215,6 +215,13 @@ def _mean(values: Sequence[float | None]) -> float | None:
     return float(np.mean([float(v) for v in values if v is not None]))
 
 
+CURVE_FIGURES = (  # per-episode figures averaged over a variant's runs and shown in its table
+    *(f"coverage_at_{d:g}m" for d in DISTANCES), *(f"coverage_at_{t:g}s" for t in TIMES),
+    *(f"path_to_{v * 100:g}pct_m" for v in LEVELS), *(f"time_to_{v * 100:g}pct_s" for v in LEVELS),
+    "goal_count", "mode_switch_count", "gaze_watching_fraction", "gaze_look_ahead_fraction",
+)
+
+
 def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
     """Per-variant figures over its episodes."""
     coverage = [r["coverage"] for r in runs]
@@ -229,14 +236,11 @@ def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
     if any(r["status"] == "ERROR" for r in runs):
         out["errors"] = sum(r["status"] == "ERROR" for r in runs)
     good = [r for r in runs if r["status"] != "ERROR"]
-    for key in ("coverage_map", "map_on_obstacles_m2", "collisions", "path_length_m", "sim_time_s",
-                *(f"coverage_at_{d:g}m" for d in DISTANCES), *(f"coverage_at_{t:g}s" for t in TIMES),
-                *(f"path_to_{v * 100:g}pct_m" for v in LEVELS), *(f"time_to_{v * 100:g}pct_s" for v in LEVELS),
-                "goal_count", "mode_switch_count", "gaze_watching_fraction", "gaze_look_ahead_fraction"):
+    for key in ("coverage_map", "map_on_obstacles_m2", "path_length_m", "sim_time_s", *CURVE_FIGURES):
         values = [r.get(key) for r in good]
         if good and any(key in r for r in good):
             out[key] = _mean(values)
-    out["collisions"] = sum(int(r.get("collisions", 0)) for r in good)
+    out["collisions"] = sum(int(r.get("collisions", 0)) for r in good)  # a count over the runs, not a mean
     return out
 
 
@@ -281,9 +285,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
 def format_table(figures: dict[str, Any]) -> str:
     """The comparison as a readable table (one column per variant)."""
     keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "collisions", "path_length_m", "sim_time_s",
-            *(f"coverage_at_{d:g}m" for d in DISTANCES), *(f"coverage_at_{t:g}s" for t in TIMES),
-            *(f"path_to_{v * 100:g}pct_m" for v in LEVELS), *(f"time_to_{v * 100:g}pct_s" for v in LEVELS),
-            "goal_count", "mode_switch_count", "gaze_watching_fraction", "gaze_look_ahead_fraction"]
+            *CURVE_FIGURES]
     names = [n for n in VARIANTS if f"{n}.coverage" in figures]
     lines = [f"exploration in {figures['world']}: {figures['seeds']} seed(s), reachable floor "
              f"{figures['reachable_area_m2']:.1f} m^2 ({figures['criterion']})",
