@@ -94,10 +94,9 @@ def run(args: argparse.Namespace) -> int:
         return fail("eval", problem)
     module = importlib.import_module(AREAS[args.area])
     try:
-        module.check_world(args.world)
+        world = module.check_world(args.world)
         extra = area_options(module, args.area, args.option)
-        if hasattr(module, "check_options"):
-            module.check_options(args.world, extra)
+        settings = module.check_options(args.world, extra) if hasattr(module, "check_options") else None
     except InputError as exc:
         return print_input_error(exc)
     except ValueError as exc:
@@ -107,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             executor = stack.enter_context(executor_for(args.workers, args.cluster))
             options = EvalOptions(args.world, list(range(args.seeds)), executor, folder, args.timeout,
-                                  args.max_time, progress_stream(args.progress), extra)
+                                  args.max_time, progress_stream(args.progress), extra, (world, settings))
             figures = module.run(options, resume=args.resume)
         except SweepInputError as exc:
             return fail("eval", str(exc))

@@ -21,7 +21,7 @@ from __future__ import annotations
 from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
 AREAS = {
     "exploration": "missions.eval.exploration",
@@ -42,3 +42,6 @@ class EvalOptions:
     max_time_s: float | None = None  # each episode's --max-time (simulated seconds); None: the mission's
     progress: TextIO | None = None
     extra: dict[str, str] = field(default_factory=dict)  # the area's own options (--option NAME=VALUE)
+    # what the area's check_world and check_options (or None) returned for these inputs, when the
+    # caller has checked them already (the command does, before any episode); None: run() checks
+    checked: tuple[Any, Any] | None = None

@@ -250,7 +250,7 @@ def _ratio(a: float | None, b: float | None) -> float | None:
 
 def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Run the episodes through the sweep runner and compute the figures."""
-    floor = check_world(options.world)
+    floor = options.checked[0] if options.checked else check_world(options.world)
     world = load_world(options.world)
     todo = episodes(options.world, options.seeds, options.max_time_s)
     rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,

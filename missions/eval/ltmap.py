@@ -325,8 +325,7 @@ def _taught(teach: Episode, report: dict[str, Any] | None) -> LandmarkTree | str
 
 def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Teach on every seed, repeat from every tree height, compute the Table-I figures."""
-    world = check_world(options.world)
-    settings = check_options(options.world, options.extra)
+    world, settings = options.checked or (check_world(options.world), check_options(options.world, options.extra))
     folder = Path(options.results_dir).resolve()
     teaches = _teach_phase(options, settings, folder, resume)
     plan: list[tuple[Episode, dict[str, Any], Level]] = []

@@ -394,8 +394,7 @@ def _learn_phase(options: EvalOptions, targets: Mapping[int, SeedTargets], setti
 
 def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Target images, a learn run per seed, navigations from random starts; the named figures."""
-    loaded = check_world(options.world)
-    settings = check_options(options.world, options.extra)
+    loaded, settings = options.checked or (check_world(options.world), check_options(options.world, options.extra))
     world = absolute_if_file(options.world)  # episodes run in other processes
     folder = Path(options.results_dir).resolve()
     grid = reachable_grid(loaded)  # once: every seed's placed targets and random starts
