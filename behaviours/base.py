@@ -37,17 +37,17 @@ class NotSetUp(RuntimeError):
     """A behaviour ticked before ``setup(clock=...)``: the tree was not set up by a runner."""
 
 
-class PortedNode(Declared):
+class PortedNode(Declared, py_trees.behaviour.Behaviour):
     """Declared ports, blackboard access and the clock, for any kind of node (mixed in first).
 
     :class:`BearingsBehaviour` (leaves) and :class:`BearingsDecorator` (decorators that also read
-    and write the blackboard, like ``LearnRoute``) are this plus a py_trees base class; a
-    subclass calls :meth:`_bind` with its ports after the py_trees constructor.
+    and write the blackboard, like ``LearnRoute``) are this plus a py_trees base class (a
+    ``Behaviour``, so this is one too); a subclass calls :meth:`_bind` with its ports after the
+    py_trees constructor.
     """
 
     def _bind(self, ports: dict[str, Any]) -> None:
         """Check ``ports`` against the declaration and grant the blackboard access they need."""
-        assert isinstance(self, py_trees.behaviour.Behaviour)
         self.inputs, self.outputs = bind_ports(type(self).__name__, self.PORTS, ports)
         self.bb = self.attach_blackboard_client(name=self.name)
         for key in read_keys(self.PORTS, self.inputs):
@@ -66,7 +66,7 @@ class PortedNode(Declared):
     @property
     def clock(self) -> Clock:
         if self._clock is None:
-            raise NotSetUp(f"{getattr(self, 'name', type(self).__name__)}: no clock; set the tree up with "
+            raise NotSetUp(f"{self.name}: no clock; set the tree up with "
                            "setup(clock=...)")
         return self._clock
 
