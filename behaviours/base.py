@@ -9,7 +9,7 @@ for outputs (remapped or not). Inside ``update()`` a behaviour calls :meth:`get_
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar, overload
 
 import py_trees
 from py_trees.common import Access
@@ -31,6 +31,8 @@ from behaviours.ports import (
 from behaviours.registry import Declared, Kind
 
 _UNSET: Any = object()
+T = TypeVar("T")
+D = TypeVar("D")
 
 
 class NotSetUp(RuntimeError):
@@ -74,32 +76,48 @@ class PortedNode(Declared, py_trees.behaviour.Behaviour):
         return self.clock.now()
 
     # -- ports -----------------------------------------------------------------------------
-    def get_input(self, port: str, default: Any = _UNSET) -> Any:
+    @overload
+    def get_input(self, port: InputPort[T]) -> T: ...
+    @overload
+    def get_input(self, port: InputPort[T], default: D) -> T | D: ...
+    @overload
+    def get_input(self, port: str, default: Any = ...) -> Any: ...
+
+    def get_input(self, port: InputPort[Any] | str, default: Any = _UNSET) -> Any:
         """An input's value now: the literal, or the referenced blackboard value.
 
-        A reference nobody has written yet gives ``default`` (``KeyError`` without one).
+        Pass the port object (``self.get_input(SPEED)``): its declared type is the value's type for
+        mypy. A port's name (``"speed"``) also works, untyped, for plugins written that way. A
+        reference nobody has written yet gives ``default`` (``KeyError`` without one).
         """
-        value = self.inputs[port]
+        name = port if isinstance(port, str) else port.name
+        value = self.inputs[name]
         if not isinstance(value, Ref):
             return value
         try:
             return self.bb.get(value.key)
         except KeyError:
             if default is _UNSET:
-                raise KeyError(f"{self.bb.name}: input {port!r} reads {value}, which is not set yet") from None
+                raise KeyError(f"{self.bb.name}: input {name!r} reads {value}, which is not set yet") from None
             return default
 
-    def set_output(self, port: str, value: Any) -> None:
-        """Write an output port's key; a value of the wrong type is a bug in the behaviour."""
-        expected = self._output_types[port]
-        if not matches_type(value, expected):
-            raise TypeError(f"{self.bb.name}: output {port!r} is declared {type_name(expected)}, "
-                            f"got {type(value).__name__}")
-        self.bb.set(self.outputs[port], value, overwrite=True)
+    @overload
+    def set_output(self, port: OutputPort[T], value: T) -> None: ...
+    @overload
+    def set_output(self, port: str, value: Any) -> None: ...
 
-    def output_key(self, port: str) -> str:
+    def set_output(self, port: OutputPort[Any] | str, value: Any) -> None:
+        """Write an output port's key; a value of the wrong type is a bug in the behaviour."""
+        name = port if isinstance(port, str) else port.name
+        expected = self._output_types[name]
+        if not matches_type(value, expected):
+            raise TypeError(f"{self.bb.name}: output {name!r} is declared {type_name(expected)}, "
+                            f"got {type(value).__name__}")
+        self.bb.set(self.outputs[name], value, overwrite=True)
+
+    def output_key(self, port: OutputPort[Any] | str) -> str:
         """The blackboard key an output port writes (after remapping)."""
-        return self.outputs[port]
+        return self.outputs[port if isinstance(port, str) else port.name]
 
 
 class BearingsBehaviour(PortedNode, py_trees.behaviour.Behaviour):

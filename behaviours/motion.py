@@ -47,13 +47,13 @@ class OdometryMotion(BearingsBehaviour):
     PORTS: ClassVar[tuple[Port, ...]] = MOTION_PORTS
 
     def odometry(self) -> Pose2D | None:
-        return self.get_input("odometry", None)
+        return self.get_input(ODOMETRY, None)
 
     def command(self, v: float, w: float) -> None:
-        self.set_output("command", VelocityCommand(v, w))
+        self.set_output(COMMAND, VelocityCommand(v, w))
 
     def blocked(self) -> bool:
-        if self.get_input("stalled", False):
+        if self.get_input(STALLED, False):
             self.command(0.0, 0.0)
             self.feedback_message = "stalled"
             return True
@@ -74,19 +74,17 @@ class OdometryMotion(BearingsBehaviour):
 
     def terminate(self, new_status: Status) -> None:
         if new_status != Status.RUNNING:
-            self.set_output("command", STOP)
+            self.set_output(COMMAND, STOP)
 
 
 @register
 class Drive(OdometryMotion):
     """Drive straight ``distance`` metres (negative: backwards), holding the starting heading."""
 
-    PORTS = (
-        InputPort("distance", float, unit="m", doc="signed distance along the starting heading"),
-        InputPort("speed", float, 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2),
-        InputPort("tolerance", float, 0.01, unit="m", doc="close enough", minimum=0.001),
-        *MOTION_PORTS,
-    )
+    DISTANCE = InputPort("distance", float, unit="m", doc="signed distance along the starting heading")
+    SPEED = InputPort("speed", float, 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2)
+    TOLERANCE = InputPort("tolerance", float, 0.01, unit="m", doc="close enough", minimum=0.001)
+    PORTS = (DISTANCE, SPEED, TOLERANCE, *MOTION_PORTS)
 
     def initialise(self) -> None:
         self._start: Pose2D | None = self.odometry()
@@ -96,11 +94,11 @@ class Drive(OdometryMotion):
             self._start = pose
         start = self._start
         travelled = (pose.x - start.x) * math.cos(start.theta) + (pose.y - start.y) * math.sin(start.theta)
-        remaining = float(self.get_input("distance")) - travelled
-        if abs(remaining) <= float(self.get_input("tolerance")):
+        remaining = self.get_input(self.DISTANCE) - travelled
+        if abs(remaining) <= self.get_input(self.TOLERANCE):
             self.command(0.0, 0.0)
             return Status.SUCCESS
-        v = ramp(remaining, float(self.get_input("speed")), LINEAR_DECEL, MIN_SPEED)
+        v = ramp(remaining, self.get_input(self.SPEED), LINEAR_DECEL, MIN_SPEED)
         w = -HEADING_GAIN * wrap_angle(pose.theta - start.theta)
         self.command(v, w)
         self.feedback_message = f"{remaining:+.2f} m to go"
@@ -111,12 +109,10 @@ class Drive(OdometryMotion):
 class Rotate(OdometryMotion):
     """Turn on the spot by ``angle`` degrees (positive: counter-clockwise)."""
 
-    PORTS = (
-        InputPort("angle", float, unit="deg", doc="signed angle to turn"),
-        InputPort("speed", float, 45.0, unit="deg/s", doc="top turn rate", minimum=1.0, maximum=300.0),
-        InputPort("tolerance", float, 1.0, unit="deg", doc="close enough", minimum=0.05),
-        *MOTION_PORTS,
-    )
+    ANGLE = InputPort("angle", float, unit="deg", doc="signed angle to turn")
+    SPEED = InputPort("speed", float, 45.0, unit="deg/s", doc="top turn rate", minimum=1.0, maximum=300.0)
+    TOLERANCE = InputPort("tolerance", float, 1.0, unit="deg", doc="close enough", minimum=0.05)
+    PORTS = (ANGLE, SPEED, TOLERANCE, *MOTION_PORTS)
 
     def initialise(self) -> None:
         self._last: float | None = None
@@ -126,11 +122,11 @@ class Rotate(OdometryMotion):
         if self._last is not None:
             self._turned += wrap_angle(pose.theta - self._last)  # unwrapped: angles beyond 180 deg work
         self._last = pose.theta
-        remaining = math.radians(float(self.get_input("angle"))) - self._turned
-        if abs(remaining) <= math.radians(float(self.get_input("tolerance"))):
+        remaining = math.radians(self.get_input(self.ANGLE)) - self._turned
+        if abs(remaining) <= math.radians(self.get_input(self.TOLERANCE)):
             self.command(0.0, 0.0)
             return Status.SUCCESS
-        w = ramp(remaining, math.radians(float(self.get_input("speed"))), ANGULAR_DECEL, MIN_TURN)
+        w = ramp(remaining, math.radians(self.get_input(self.SPEED)), ANGULAR_DECEL, MIN_TURN)
         self.command(0.0, w)
         self.feedback_message = f"{math.degrees(remaining):+.1f} deg to go"
         return Status.RUNNING
@@ -140,24 +136,22 @@ class Rotate(OdometryMotion):
 class DriveTo(OdometryMotion):
     """Drive to the point (x, y) of the odometry frame: turn towards it, then drive while steering."""
 
-    PORTS = (
-        InputPort("x", float, unit="m", doc="goal x in the odometry frame"),
-        InputPort("y", float, unit="m", doc="goal y in the odometry frame"),
-        InputPort("speed", float, 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2),
-        InputPort("tolerance", float, 0.05, unit="m", doc="goal radius", minimum=0.005),
-        *MOTION_PORTS,
-    )
+    X = InputPort("x", float, unit="m", doc="goal x in the odometry frame")
+    Y = InputPort("y", float, unit="m", doc="goal y in the odometry frame")
+    SPEED = InputPort("speed", float, 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2)
+    TOLERANCE = InputPort("tolerance", float, 0.05, unit="m", doc="goal radius", minimum=0.005)
+    PORTS = (X, Y, SPEED, TOLERANCE, *MOTION_PORTS)
     TURN_IN_PLACE = math.radians(30.0)  # heading error above which the robot turns before driving
 
     def step(self, pose: Pose2D) -> Status:
-        dx, dy = float(self.get_input("x")) - pose.x, float(self.get_input("y")) - pose.y
+        dx, dy = self.get_input(self.X) - pose.x, self.get_input(self.Y) - pose.y
         distance = math.hypot(dx, dy)
-        if distance <= float(self.get_input("tolerance")):
+        if distance <= self.get_input(self.TOLERANCE):
             self.command(0.0, 0.0)
             return Status.SUCCESS
         error = wrap_angle(math.atan2(dy, dx) - pose.theta)
         w = ramp(error, math.radians(60.0), ANGULAR_DECEL, 0.0) if error else 0.0
-        v = 0.0 if abs(error) > self.TURN_IN_PLACE else ramp(distance, float(self.get_input("speed")),
+        v = 0.0 if abs(error) > self.TURN_IN_PLACE else ramp(distance, self.get_input(self.SPEED),
                                                               LINEAR_DECEL, MIN_SPEED) * math.cos(error)
         self.command(v, w)
         self.feedback_message = f"{distance:.2f} m to go"

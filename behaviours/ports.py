@@ -22,7 +22,7 @@ import types
 import typing
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, NewType, Union
+from typing import Any, Generic, NewType, TypeVar, Union
 
 from maps.located import describe_value
 
@@ -47,6 +47,8 @@ class _Missing:
 
 REQUIRED: Any = _Missing()
 
+T = TypeVar("T")
+
 
 @dataclass(frozen=True, slots=True)
 class Ref:
@@ -68,16 +70,20 @@ class Ref:
 
 
 @dataclass(frozen=True, slots=True)
-class InputPort:
+class InputPort(Generic[T]):
     """An input of a node type: a literal or a ``{/ns/key}`` reference of type ``type``.
 
     ``unit`` is the unit a mission writes the value in; ``choices`` restrict a ``str``;
     ``minimum``/``maximum`` bound numbers; ``literal_only`` ports configure the node and cannot
     change while it runs (they take no reference).
+
+    The port is generic in its value type, so ``node.get_input(SPEED)`` is a ``float`` to mypy
+    (``InputPort("speed", float, ...)`` infers ``InputPort[float]``). A union type cannot be
+    inferred from its value: annotate the port (``GOAL: InputPort[Goal | None] = InputPort(...)``).
     """
 
     name: str
-    type: Any
+    type: type[T] | types.UnionType
     default: Any = REQUIRED
     unit: str = ""
     doc: str = ""
@@ -97,11 +103,15 @@ class InputPort:
 
 
 @dataclass(frozen=True, slots=True)
-class OutputPort:
-    """An output of a node type: it writes values of ``type`` to blackboard key ``key`` (remappable)."""
+class OutputPort(Generic[T]):
+    """An output of a node type: it writes values of ``type`` to blackboard key ``key`` (remappable).
+
+    Generic in its value type like :class:`InputPort`: ``node.set_output(COMMAND, value)`` checks
+    ``value`` against the port's type under mypy, and at run time against the declaration.
+    """
 
     name: str
-    type: Any
+    type: type[T] | types.UnionType
     key: str
     doc: str = ""
     unit: str = ""
@@ -110,7 +120,7 @@ class OutputPort:
         return f"{self.name} -> {{{self.key}}}: {type_name(self.type)}. {self.doc}".strip()
 
 
-Port = InputPort | OutputPort
+Port = InputPort[Any] | OutputPort[Any]
 
 
 # -- type names and compatibility ------------------------------------------------------------------

@@ -13,6 +13,7 @@ Z-infinity rotation becomes the target, and the node succeeds so the mission res
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -32,10 +33,9 @@ from behaviours.route import (
     lost_threshold,
     zinf_motion,
 )
+from behaviours.telemetry import Drawing, Figure, Lines
 from drivers.interfaces import STOP, VelocityCommand
-from maps.ltmap import LandmarkTree
 from perception.geometry import Pose2D, wrap_angle
-from perception.observation import Observation
 
 
 def lying_eight(width: float, points: int = 64) -> np.ndarray:
@@ -56,15 +56,13 @@ class SearchPattern(BearingsBehaviour):
     valid Z-infinity rotation; it becomes the target (``found`` output).
     """
 
-    PORTS = (
-        InputPort("width", float, 1.2, unit="m", minimum=0.1, maximum=10.0, doc="the eight from end to end"),
-        InputPort("speed", float, 0.15, unit="m/s", minimum=0.01, maximum=1.2, doc="driving speed"),
-        InputPort("eights", int, 2, minimum=1, doc="eights driven before giving up"),
-        InputPort("window", int, 2, minimum=0, doc="viewframes past the target also searched for"),
-        MIN_MATCHES,
-        LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, ODOMETRY, STALLED, COMMAND,
-        OutputPort("found", type=RouteProgress, key=PROGRESS_KEY, doc="the progress with the viewframe found"),
-    )  # fmt: skip
+    WIDTH = InputPort("width", float, 1.2, unit="m", minimum=0.1, maximum=10.0, doc="the eight from end to end")
+    SPEED = InputPort("speed", float, 0.15, unit="m/s", minimum=0.01, maximum=1.2, doc="driving speed")
+    EIGHTS = InputPort("eights", int, 2, minimum=1, doc="eights driven before giving up")
+    WINDOW = InputPort("window", int, 2, minimum=0, doc="viewframes past the target also searched for")
+    FOUND = OutputPort("found", type=RouteProgress, key=PROGRESS_KEY, doc="the progress with the viewframe found")
+    PORTS = (WIDTH, SPEED, EIGHTS, WINDOW, MIN_MATCHES,
+             LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, ODOMETRY, STALLED, COMMAND, FOUND)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -85,8 +83,8 @@ class SearchPattern(BearingsBehaviour):
         self.recoveries += 1
 
     def update(self) -> Status:
-        pose: Pose2D | None = self.get_input("odometry", None)
-        if self.get_input("stalled", False):
+        pose = self.get_input(ODOMETRY, None)
+        if self.get_input(STALLED, False):
             self.feedback_message = "stalled"
             return self._stop(Status.FAILURE)
         if pose is None:
@@ -99,54 +97,56 @@ class SearchPattern(BearingsBehaviour):
         self._turned += abs(wrap_angle(pose.theta - self._last_theta))
         self._last_theta = pose.theta
         lap = 2.0 * math.pi  # one circle of the eight
-        if self._turned >= 2 * lap * int(self.get_input("eights")):
-            self.feedback_message = f"the trail was not found in {self.get_input('eights')} eights"
+        eights = self.get_input(self.EIGHTS)
+        if self._turned >= 2 * lap * eights:
+            self.feedback_message = f"the trail was not found in {eights} eights"
             return self._stop(Status.FAILURE)
-        speed = float(self.get_input("speed"))
-        turn = speed / (float(self.get_input("width")) / 4.0)
+        speed = self.get_input(self.SPEED)
+        turn = speed / (self.get_input(self.WIDTH) / 4.0)
         left = int(self._turned // lap) % 2 == 0
-        self.set_output("command", VelocityCommand(speed, turn if left else -turn))
+        self.set_output(COMMAND, VelocityCommand(speed, turn if left else -turn))
         self.feedback_message = f"searching: {math.degrees(self._turned):.0f} deg of the eight"
         return Status.RUNNING
 
     def _stop(self, status: Status) -> Status:
-        self.set_output("command", STOP)
+        self.set_output(COMMAND, STOP)
         return status
 
     def _found(self) -> bool:
-        tree: LandmarkTree | None = self.get_input("ltmap", None)
-        progress: RouteProgress | None = self.get_input("progress", None)
-        observation: Observation | None = self.get_input("observation", None)
+        tree = self.get_input(LTMAP_IN, None)
+        progress = self.get_input(PROGRESS_IN, None)
+        observation = self.get_input(OBSERVATION_IN, None)
         if tree is None or progress is None or observation is None or progress.finished:
             return False
         if observation.stamp == self._stamp:
             return False
         self._stamp = observation.stamp
         last = tree.viewframe_count - 1
-        window = int(self.get_input("window"))
+        window = self.get_input(self.WINDOW)
         candidates = [progress.target + progress.direction * k for k in range(window + 1)]
         for index in (c for c in candidates if 0 <= c <= last):
             matches = tree.match(index, observation)
-            if len(matches) < lost_threshold(len(tree.viewframe(index)), int(self.get_input("min_matches"))):
+            if len(matches) < lost_threshold(len(tree.viewframe(index)), self.get_input(MIN_MATCHES)):
                 continue
             if zinf_motion(matches.ref, matches.cur, self._rng)[0].rotation_ok:
-                self.set_output("found", progress.retargeted(index, self.now()))
+                self.set_output(self.FOUND, progress.retargeted(index, self.now()))
                 self.found_again += 1
                 self.feedback_message = f"the trail is found again at viewframe {index}"
                 return True
         return False
 
-    def report_sections(self) -> dict[str, dict[str, Any]]:
-        return {"ltmap": {"recoveries": self.recoveries, "recoveries_found": self.found_again}}
+    def figures(self) -> Iterator[Figure]:
+        yield Figure("ltmap", "recoveries", self.recoveries)
+        yield Figure("ltmap", "recoveries_found", self.found_again)
 
-    def log_rerun(self, rec: Any) -> None:
-        """The eight being driven, in the odometry frame, while the search runs."""
+    def drawings(self) -> Iterator[Drawing]:
+        """The eight being driven, in the odometry frame, each time a search starts."""
         origin = self._origin
         if origin is None or origin is self._logged_origin:
             return
         self._logged_origin = origin
-        local = lying_eight(float(self.get_input("width")))
+        local = lying_eight(self.get_input(self.WIDTH))
         c, s = math.cos(origin.theta), math.sin(origin.theta)
         world = np.column_stack((origin.x + c * local[:, 0] - s * local[:, 1],
                                  origin.y + s * local[:, 0] + c * local[:, 1]))
-        rec.log("odometry_frame/route/search_pattern", rec.LineStrips2D([world], colors=[[255, 0, 160]]))
+        yield Lines("odometry_frame/route/search_pattern", [world], colours=(255, 0, 160))

@@ -10,8 +10,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import py_trees
 from py_trees.common import Status
+
+from behaviours.telemetry import Arrows, Drawing, Draws, Event, Lines, Picture, Plot, Points, Reports
 
 STATUS_CODE = {Status.INVALID: 0, Status.RUNNING: 1, Status.SUCCESS: 2, Status.FAILURE: 3}
 
@@ -29,10 +32,11 @@ class Recorder:
         rr.init("bearings", recording_id=recording_id, spawn=False)
         rr.save(str(self.path))
         self._last_status: dict[str, Status] = {}
+        self._last_figure: dict[str, Any] = {}
         rr.log("tree/status_legend", rr.TextDocument("0 invalid, 1 running, 2 success, 3 failure"), static=True)
 
     def log_tick(self, *, time_s: float, tick: int, root: py_trees.behaviour.Behaviour, odometry: Any,
-                 command: Any, observers: Sequence[Any] = ()) -> None:
+                 command: Any, observers: Sequence[Any] = (), nodes: Sequence[Any] = ()) -> None:
         rr = self.rr
         rr.set_time(self.timeline, duration=time_s)
         rr.set_time("tick", sequence=tick)
@@ -52,6 +56,46 @@ class Recorder:
                 rr.log("tree/events", rr.TextLog(message))
         for observer in observers:
             observer.log_rerun(rr)
+        for node in nodes:
+            self.log_node(node)
+
+    def log_node(self, node: Any) -> None:
+        """A node's figures (numbers, when they change) and drawings."""
+        if isinstance(node, Reports):
+            for figure in node.figures():
+                value = figure.value
+                if isinstance(value, (int, float)) and not isinstance(value, bool):
+                    entity = f"figures/{figure.section}/{figure.name.replace('.', '/')}"
+                    if self._last_figure.get(entity) != value:
+                        self._last_figure[entity] = value
+                        self.rr.log(entity, self.rr.Scalars([float(value)]))
+        if isinstance(node, Draws):
+            for drawing in node.drawings():
+                self.draw(drawing)
+        elif callable(log := getattr(node, "log_rerun", None)):  # issue 20: going
+            log(self.rr)
+
+    def draw(self, drawing: Drawing) -> None:
+        """One drawing as the rerun archetype that shows it."""
+        rr = self.rr
+        match drawing:
+            case Points(entity, positions, colours, radius, labels):
+                positions = np.asarray(positions)
+                kind = rr.Points3D if positions.ndim == 2 and positions.shape[1] == 3 else rr.Points2D
+                rr.log(entity, kind(positions, radii=radius, colors=_colours(colours),
+                                    labels=list(labels) or None))
+            case Lines(entity, strips, colours, radius):
+                three = any(np.asarray(s).shape[-1] == 3 for s in strips)
+                kind = rr.LineStrips3D if three else rr.LineStrips2D
+                rr.log(entity, kind(strips, colors=_colours(colours), radii=radius))
+            case Arrows(entity, vectors, colours, origins):
+                rr.log(entity, rr.Arrows2D(vectors=vectors, origins=origins, colors=_colours(colours)))
+            case Picture(entity, image):
+                rr.log(entity, rr.Image(image))
+            case Event(entity, text):
+                rr.log(entity, rr.TextLog(text))
+            case Plot(entity, value):
+                rr.log(entity, rr.Scalars([float(value)]))
 
     def log_stop(self, *, time_s: float, tick: int) -> None:
         """The stop every run ends with: the last command in the recording is a zero velocity."""
@@ -64,6 +108,11 @@ class Recorder:
 
     def close(self) -> None:
         self.rr.disconnect()
+
+
+def _colours(colours: Any) -> list[Any]:
+    """rerun takes a list of colours: one for all, or one per item."""
+    return [colours] if isinstance(colours, tuple) else list(colours)
 
 
 def _walk(node: py_trees.behaviour.Behaviour, prefix: str, seen: dict[str, int]):

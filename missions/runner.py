@@ -46,6 +46,7 @@ from py_trees.common import Status
 
 from behaviours.clock import TickClock
 from behaviours.keys import COMMAND_KEYS, input_key
+from behaviours.telemetry import Draws, Reports, Sections, section
 from drivers.interfaces import STOP, PanTiltCommand, Robot, VelocityCommand
 from maps.store import write_json
 from missions.builder import build_root
@@ -120,7 +121,7 @@ class Runner:
         self.last_command: VelocityCommand = STOP
         self._last_ptu: PanTiltCommand | None = None
         self._recorder: Recorder | None = None
-        self._loggers: list[Any] = []
+        self._drawers: list[Any] = []
         self._wall_start = time.monotonic()
         py_trees.blackboard.Blackboard.clear()  # one run, one blackboard: nothing leaks between runs
         root, self.task = build_root(mission)
@@ -172,7 +173,8 @@ class Runner:
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
         self.tree.setup(clock=self.clock, robot=self.robot)  # hand every node the clock and the drivers
-        self._loggers = [node for node in self.root.iterate() if callable(getattr(node, "log_rerun", None))]
+        self._drawers = [node for node in self.root.iterate() if isinstance(node, Reports | Draws)
+                         or callable(getattr(node, "log_rerun", None))]
 
     def _loop(self) -> tuple[str, str]:
         last_progress = 0.0
@@ -250,7 +252,7 @@ class Runner:
         if self._recorder is not None:
             self._recorder.log_tick(time_s=self.clock.now(), tick=self.ticks + 1, root=self.root,
                                     odometry=self._get("/robot/odometry"), command=self.last_command,
-                                    observers=(*self.observers, *self._loggers))
+                                    observers=self.observers, nodes=self._drawers)
 
     # -- helpers ---------------------------------------------------------------------------------
     def _get(self, key: str) -> Any:
@@ -261,17 +263,17 @@ class Runner:
 
     def _node_sections(self) -> dict[str, dict[str, Any]]:
         """What the tree's nodes add to the report (a node that fails to say is noted, not fatal)."""
-        sections: dict[str, dict[str, Any]] = {}
+        gathered = Sections()
         for node in self.root.iterate():
-            method = getattr(node, "report_sections", None)
-            if not callable(method):
-                continue
             try:
-                for section, values in method().items():
-                    sections.setdefault(section, {}).update(values)
+                if isinstance(node, Reports):
+                    gathered.add(node.figures())
+                elif callable(method := getattr(node, "report_sections", None)):  # issue 20: going
+                    for name, values in method().items():
+                        gathered.add(section(name, values))
             except Exception as exc:  # noqa: BLE001 - the report must be written whatever a node does
-                sections.setdefault("report_errors", {})[node.name] = describe_exception(exc)
-        return sections
+                gathered.sections.setdefault("report_errors", {})[node.name] = describe_exception(exc)
+        return gathered.sections
 
     def _outcome_reason(self) -> str:
         if self.root.status == Status.SUCCESS:
@@ -309,8 +311,8 @@ class Runner:
             report["sim_time_s"] = round(result.time_s, 6)
         for observer in self.observers:
             report.update(observer.report_sections(mission.evaluation))
-        for section, values in self._node_sections().items():
-            report.setdefault(section, {}).update(values)
+        for name, values in self._node_sections().items():
+            report.setdefault(name, {}).update(values)
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}

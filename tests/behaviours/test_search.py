@@ -10,6 +10,7 @@ from py_trees.common import Status
 
 from behaviours.route import RouteProgress
 from behaviours.search import SearchPattern, lying_eight
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from perception.geometry import Pose2D
 from perception.observation import Observation
@@ -45,7 +46,7 @@ def test_search_drives_the_eight_and_fails_when_the_trail_stays_lost():
     xy = np.array([(p.x, p.y) for p in base.trail])
     assert np.ptp(xy[:, 1]) == pytest.approx(1.2, abs=0.08)  # across the eight: two circles side by side
     assert math.dist(xy[0], xy[-1]) < 0.1  # back where it started
-    assert node.report_sections()["ltmap"] == {"recoveries": 1, "recoveries_found": 0}
+    assert report_sections(node)["ltmap"] == {"recoveries": 1, "recoveries_found": 0}
 
 
 def test_search_succeeds_where_the_trail_is_found_and_retargets():
