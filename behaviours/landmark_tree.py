@@ -23,8 +23,8 @@ from py_trees.common import Status
 from behaviours.base import BearingsBehaviour
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
-from maps.ltmap import DEFAULT_MIN_LANDMARKS, LandmarkTree, MapSummary
-from maps.ltmap_file import load_ltmap, save_ltmap
+from maps.ltmap.file import load_ltmap, save_ltmap
+from maps.ltmap.tree import DEFAULT_MIN_LANDMARKS, LandmarkTree, MapSummary
 from maps.store import InputError
 
 LTMAP_KEY = "/map/ltmap"

@@ -62,7 +62,7 @@ from behaviours.motion import COMMAND, ODOMETRY, STALLED
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from drivers.interfaces import STOP, VelocityCommand
-from maps.ltmap import LandmarkTree
+from maps.ltmap.tree import LandmarkTree
 from perception.geometry import wrap_angle
 from perception.heading import HeadingFilter, heading_flipped, scaled_velocity
 from perception.matching import LandmarkMatches

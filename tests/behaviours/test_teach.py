@@ -10,7 +10,7 @@ from py_trees.common import Status
 from behaviours.landmark_tree import LoadMap, PruneMap
 from behaviours.teach import LearnRoute
 from behaviours.testing import BehaviourHarness
-from maps.ltmap_file import load_ltmap, save_ltmap
+from maps.ltmap.file import load_ltmap, save_ltmap
 from perception.synthetic_route import observe_route, straight_route
 from tests.behaviours.routes import WORLD, taught_map
 

@@ -11,8 +11,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from maps.ltmap import IDS, LandmarkSet, LandmarkTree, attach_level, compensate
-from maps.ltmap_file import decode_ltmap, encode_ltmap
+from maps.ltmap.file import decode_ltmap, encode_ltmap
+from maps.ltmap.tree import IDS, LandmarkSet, LandmarkTree, attach_level, compensate
 from perception.observation import Observation
 from perception.similarity import bearing_angles
 from perception.synthetic import unit

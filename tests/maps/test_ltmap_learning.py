@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from maps.ltmap import IDS, LearnConfig, RouteLearner, threshold_angle
+from maps.ltmap.tree import IDS, LearnConfig, RouteLearner, threshold_angle
 from perception.geometry import Pose2D
 from perception.observation import Observation
 from perception.similarity import DEFAULT_SCALE, bearing_angles, delta_t

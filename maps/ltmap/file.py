@@ -15,7 +15,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from maps.ltmap import LandmarkTree
+from maps.ltmap.tree import LandmarkTree
 from maps.mapfile import MapFile, decode_map, encode_map, read_map_file, write_map_file
 from maps.store import Diagnostic, InputError
 

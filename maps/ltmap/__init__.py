@@ -1,0 +1,1 @@
+"""The Landmark-Tree map (LT-map)."""
