@@ -24,7 +24,8 @@ from behaviours.base import BearingsBehaviour
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from maps.ltmap.file import load_ltmap, save_ltmap
-from maps.ltmap.tree import DEFAULT_MIN_LANDMARKS, LandmarkTree, MapSummary
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
+from maps.ltmap.tree import LandmarkTree, MapSummary
 from maps.store import InputError
 
 LTMAP_KEY = "/map/ltmap"

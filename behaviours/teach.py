@@ -26,7 +26,9 @@ from behaviours.landmark_tree import LTMAP_OUT, save_map, summary_section
 from behaviours.motion import ODOMETRY
 from behaviours.ports import InputPort, Port, Ref
 from behaviours.registry import register
-from maps.ltmap.tree import DEFAULT_MIN_LANDMARKS, DEFAULT_THRESHOLD, LearnConfig, LearnStep, RouteLearner
+from maps.ltmap.learner import LearnConfig, LearnStep, RouteLearner
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
+from maps.ltmap.tree import DEFAULT_THRESHOLD
 from maps.store import InputError
 from perception.geometry import Pose2D
 from perception.observation import Observation

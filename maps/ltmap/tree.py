@@ -1,42 +1,26 @@
-"""The Landmark-Tree map (LT-map): viewframes as branches of one tree of landmarks.
+"""The LT-map itself: landmarks in a tree whose root-to-leaf branches are the viewframes of a route.
 
 Jäger, Mair et al., IROS 2013 (DESIGN.md, algorithm 1). A *landmark* is a descriptor (a binary
-ORB row, or the id of the simulator's ideal bearings sensor) with a unit bearing compensated for
-the robot's rotation. A *viewframe* is the set of landmarks seen from one place of a taught route:
-the union of the nodes on a branch from the root to a leaf. Each landmark lives in exactly one
-node, so a landmark seen from many places is stored once; far, persistent landmarks sit near the
-root and short-lived local ones near the leaves. Pure: numpy arrays and dataclasses, no I/O
-(``maps/ltmap_file.py`` saves and loads).
+ORB row, or the id of the simulator's ideal bearings sensor) with a unit bearing in the route
+frame (compensated for the robot's rotation, :func:`maps.ltmap.learner.compensate`). A
+*viewframe* is the set of landmarks seen from one place of a taught route: the union of the
+nodes on a branch from the root to a leaf. Each landmark lives in exactly one node, so a
+landmark seen from many places is stored once; far, persistent landmarks sit near the root and
+short-lived local ones near the leaves. Pure: numpy arrays and dataclasses, no I/O
+(:mod:`maps.ltmap.file` saves and loads). How the paper is read here (where it is vague):
 
-How the paper is read here (where it is vague, the choice and why):
-
-- **Route frame.** Stored bearings are body-frame bearings rotated by the camera's heading in the
-  route frame (odometry heading plus pan), given by the caller: "compensated for the robot's
-  rotation". Route following estimates the remaining rotation with Z-infinity, so heading drift
-  along the route costs nothing there; while teaching it adds to ``delta_t``.
-- **Tracking.** A landmark of the last viewframe is *tracked* when the current observation
-  matches it (ratio test and mutual check on descriptors, equal ids for the ideal sensor)
-  against the viewframe's cached landmark stack. Features that match no viewframe landmark are
-  candidates for the next viewframe; candidates not matched against the previous image are
-  *volatile* and rejected.
-- **New viewframe** when ``delta_t`` (eq. 1, :func:`perception.similarity.delta_t`: mean
-  Pseudo-Huber cost of bearing changes) of the landmarks tracked since the last viewframe
-  exceeds the threshold. The change is measured from the bearings they had when that viewframe
-  was made (the learner keeps them), so ``delta_t`` starts at 0 at every viewframe. Nothing
-  tracked is ``inf``: losing every landmark also makes a viewframe (but seeing nothing at all,
-  say in the dark, makes no empty ones).
 - **One bearing per landmark.** A landmark stored once and shared by several viewframes has one
   bearing, the one it was stored with. A tracked landmark is shared with the new viewframe only
-  while its current bearing stays within ``share_angle`` of the stored one; by default the angle
-  whose eq. 1 cost equals the threshold (about 3 deg), so that at a viewframe's own place
-  ``delta_t`` stays under the threshold and route following can switch there. A landmark that
-  moved further (a near landmark, after some travel) counts as lost for the tree, and its current
-  sighting is stored again in the new leaf with its current bearing.
+  while its current bearing stays within ``share_angle`` of the stored one (the learner's
+  default: about 3 deg). A landmark that moved further (a near landmark, after some travel)
+  counts as lost for the tree, and its current sighting is stored again in the new leaf with
+  its current bearing.
 - **Levels.** Every leaf is at the same depth, the tree's *height*: a level is a time scale, the
   leaves hold what was seen from one place only, their parents what a run of neighbouring places
   shared, and so on up to the root, what the whole route saw. "Cut the lowest level" then drops
   the most local landmarks of the whole route at once, as the paper's memory table shows (a few
-  heights between the full tree and a lost robot), not one viewframe at a time.
+  heights between the full tree and a lost robot), not one viewframe at a time
+  (:mod:`maps.ltmap.prune`).
 - **Learning (algorithm 1).** The landmarks new since the last viewframe go into the new leaf.
   The new branch shares the top of the last viewframe's branch ``n_0 .. n_(j-1)`` (``j = 0``: a
   new root above the old one) and continues with fresh nodes down to the leaf level. The tracked
@@ -56,70 +40,45 @@ How the paper is read here (where it is vague, the choice and why):
   that tracked it. On a synthetic corridor (tests, benchmark) over 99% of a viewframe's
   landmarks are visible from it within 5 deg of their stored bearing, for 5-10% more memory
   than moving every tracked landmark up (which leaves about a third of them wrong).
-- **Pruning (``prune_level``).** The lowest level (every leaf) is cut: the first and the last
-  viewframe (start and goal) shift their leaf's landmarks into the parent, every other leaf's
-  landmarks are deleted; viewframes that now end in the same node are one viewframe (the
-  earliest keeps its place in the route). Viewframes left with fewer than ``min_landmarks`` (50,
-  the paper's minimum for homing) are deleted, except the first and the last (the route must
-  keep its start and goal), and with them every node no viewframe passes through; viewframes
-  whose landmark sets became identical (they differ only by empty nodes) are merged; a root with
-  a single child is merged into it, which lowers the height again (the tree is compressed).
-  ``prune_to(budget)`` cuts levels until the map fits, or reports that it cannot and leaves the
-  map as it was. Surviving landmarks keep their order; a prune reports the new index of every
-  old landmark, so callers holding landmark indices (the learner) can follow.
-- **Memory** (``memory_bytes``) is exactly what :meth:`LandmarkTree.to_arrays` holds, i.e. what a
-  saved map stores besides its header: per landmark its descriptor row (32 bytes for ORB) or id
-  (8 bytes) and its unit bearing (3 x float32, 12 bytes); per node its parent and its landmark
-  count (2 x int32); per viewframe its leaf (int32). Landmarks are stored grouped by node, so a
-  landmark's node costs nothing. Caches and the learner's bookkeeping are not map content.
-- **Matching cache.** Each viewframe's landmark stack (descriptors or ids, bearings, map indices)
-  is built once and kept until the map changes; a change (a new viewframe, pruning) clears every
-  entry. With ids, a branch holding one id twice (a landmark stored again after its bearing
-  moved) keeps the deepest, most local copy. With descriptors both copies stay, and the ratio
-  test discards the pair: an ambiguous landmark is better unused than matched to a stale bearing.
+- **Memory** (:meth:`LandmarkTree.memory_bytes`) is exactly what :meth:`LandmarkTree.to_arrays`
+  holds (:mod:`maps.ltmap.arrays`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-from perception.matching import LandmarkMatches, Landmarks, match_features, match_landmarks
+from maps.ltmap.arrays import (
+    BEARING_DTYPE,
+    ID_DTYPE,
+    IDS,
+    INDEX_DTYPE,
+    NODE_BYTES,
+    VIEWFRAME_BYTES,
+    check_kind,
+    checked_arrays,
+    data_name,
+    empty_data,
+    preorder,
+    readonly,
+)
+from maps.ltmap.matching import Viewframe, ViewframeCache, match_viewframe, stack_viewframe
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS, PruneReport, PruneStep, cut_lowest_level, follow
+from perception.matching import LandmarkMatches
 from perception.observation import Observation
-from perception.similarity import DEFAULT_SCALE, bearing_angles, delta_t
+from perception.similarity import bearing_angles
 
-IDS = "ids"  # the kind of a map built from the ideal bearings sensor (landmark ids, no descriptors)
-DESCRIPTOR_KINDS = {"orb": (32, np.uint8), "brisk": (64, np.uint8), "sift": (128, np.float32)}
-DEFAULT_MIN_LANDMARKS = 50  # the paper's minimum for homing: smaller viewframes are pruned away
 # eq. 1 threshold (rad^2; mean Pseudo-Huber cost, delta 2 deg): about 3 deg of mean bearing change
 DEFAULT_THRESHOLD = 1.0e-3
 NO_GATE = float("inf")  # share every tracked landmark, whatever its bearing now
-BEARING_DTYPE = np.float32
-INDEX_DTYPE = np.int32
-ID_DTYPE = np.int64
-NODE_BYTES = 2 * np.dtype(INDEX_DTYPE).itemsize  # parent + landmark count
-VIEWFRAME_BYTES = np.dtype(INDEX_DTYPE).itemsize  # the viewframe's leaf
-STRUCTURE_ARRAYS = ("bearings", "node_parent", "node_size", "viewframe_leaf")
-
-
-def compensate(bearings: np.ndarray, heading: float) -> np.ndarray:
-    """Body-frame unit bearings (N x 3) seen with the camera at ``heading`` (rad, counter-clockwise
-    about z), in the route frame: what "compensated for the robot's rotation" means here."""
-    return Rotation.from_euler("z", heading).apply(np.asarray(bearings, dtype=np.float64).reshape(-1, 3))
 
 
 def _unit(vectors: np.ndarray) -> np.ndarray:
     v = np.asarray(vectors, dtype=np.float64)
     return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-30)
-
-
-def _readonly(array: np.ndarray) -> np.ndarray:
-    view = array.view()
-    view.flags.writeable = False
-    return view
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -152,25 +111,6 @@ class LandmarkSet:
         return cls(chosen, descriptors=observation.features.descriptors[index])
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Viewframe:
-    """The landmarks of one viewframe stacked for matching (built once, kept until the map changes).
-
-    ``landmarks`` are map indices; ``bearings`` unit (K x 3, route frame, float64); ``descriptors``
-    (K x W) or ``ids`` (K,, sorted); ``matchable``: the descriptor set :func:`match_landmarks` takes.
-    """
-
-    index: int
-    landmarks: np.ndarray
-    bearings: np.ndarray
-    descriptors: np.ndarray | None
-    ids: np.ndarray | None
-    matchable: Landmarks | None
-
-    def __len__(self) -> int:
-        return len(self.landmarks)
-
-
 @dataclass(frozen=True, slots=True)
 class MapSummary:
     """What ``bearings map info`` prints and a mission report's ``ltmap`` section holds."""
@@ -183,42 +123,6 @@ class MapSummary:
     memory_bytes: int
     landmarks_per_level: tuple[int, ...]
     threshold: float
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class PruneStep:
-    """One level cut by :meth:`LandmarkTree.prune_level`; ``landmark_index[i]`` is the new index of
-    old landmark ``i`` (-1: deleted), ``viewframe_index[v]`` the new index of old viewframe ``v``
-    (merged ones: the viewframe they merged into; -1: deleted)."""
-
-    height_before: int
-    height_after: int
-    bytes_before: int
-    bytes_after: int
-    landmarks_removed: int
-    viewframes_merged: int
-    viewframes_deleted: int
-    landmark_index: np.ndarray
-    viewframe_index: np.ndarray
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class PruneReport:
-    """What :meth:`LandmarkTree.prune_to` did. ``fits`` False: even height 0 exceeds the budget and
-    the map was left unchanged (``smallest_bytes`` is what it would have reached)."""
-
-    budget_bytes: int
-    fits: bool
-    bytes_before: int
-    bytes_after: int
-    smallest_bytes: int
-    steps: tuple[PruneStep, ...]
-    landmark_index: np.ndarray
-    viewframe_index: np.ndarray
-
-    @property
-    def levels_cut(self) -> int:
-        return len(self.steps) if self.fits else 0
 
 
 def shared_cover(leaves: np.ndarray) -> np.ndarray:
@@ -263,22 +167,22 @@ class _Rows:
 class LandmarkTree:
     """An LT-map: landmarks in a tree whose root-to-leaf branches are the viewframes of a route.
 
-    Viewframes are numbered in route order (0: start, last: goal). Built by :class:`RouteLearner`
-    (or :meth:`add_viewframe`), shrunk by :meth:`prune_level` / :meth:`prune_to`, matched against
-    observations by :meth:`match` (the hot path of route following, cached per viewframe).
+    Viewframes are numbered in route order (0: start, last: goal). Built by
+    :class:`~maps.ltmap.learner.RouteLearner` (or :meth:`add_viewframe`), shrunk by
+    :meth:`prune_level` / :meth:`prune_to`, matched against observations by :meth:`match` (the hot
+    path of route following, cached per viewframe).
     """
 
     def __init__(self, kind: str, *, threshold: float = DEFAULT_THRESHOLD) -> None:
-        if kind != IDS and kind not in DESCRIPTOR_KINDS:
-            raise ValueError(f"unknown landmark kind {kind!r} (expected {IDS} or one of {', '.join(DESCRIPTOR_KINDS)})")
+        check_kind(kind)
         if not (np.isfinite(threshold) and threshold > 0):
             raise ValueError(f"threshold must be a positive number, got {threshold}")
         self.kind = kind
         self.threshold = float(threshold)
         self._parent: list[int] = []
         self._leaves: list[int] = []
-        self._rows = _empty_rows(kind)
-        self._cache: dict[int, Viewframe] = {}
+        self._rows = _Rows(np.zeros(0, dtype=np.int64), np.zeros((0, 3), dtype=BEARING_DTYPE), empty_data(kind))
+        self._cache = ViewframeCache()
 
     # ----- size and shape ---------------------------------------------------------------------
 
@@ -305,7 +209,7 @@ class LandmarkTree:
         return len(self.branch_nodes(0)) - 1 if self._leaves else 0
 
     def memory_bytes(self) -> int:
-        """Bytes of the map's content: exactly the ``nbytes`` of :meth:`to_arrays` (see the module doc)."""
+        """Bytes of the map's content: exactly the ``nbytes`` of :meth:`to_arrays` (see :mod:`maps.ltmap.arrays`)."""
         data = self._rows.data
         row = 3 * np.dtype(BEARING_DTYPE).itemsize + int(np.prod(data.shape[1:], dtype=np.int64)) * data.itemsize
         return self.landmark_count * row + self.node_count * NODE_BYTES + self.viewframe_count * VIEWFRAME_BYTES
@@ -339,20 +243,20 @@ class LandmarkTree:
     @property
     def bearings(self) -> np.ndarray:
         """Per landmark its stored unit bearing (N x 3 float32, route frame)."""
-        return _readonly(self._rows.bearings)
+        return readonly(self._rows.bearings)
 
     @property
     def descriptors(self) -> np.ndarray | None:
-        return None if self.kind == IDS else _readonly(self._rows.data)
+        return None if self.kind == IDS else readonly(self._rows.data)
 
     @property
     def ids(self) -> np.ndarray | None:
-        return _readonly(self._rows.data) if self.kind == IDS else None
+        return readonly(self._rows.data) if self.kind == IDS else None
 
     @property
     def landmark_nodes(self) -> np.ndarray:
         """The node each landmark lives in."""
-        return _readonly(self._rows.node)
+        return readonly(self._rows.node)
 
     @property
     def node_parents(self) -> tuple[int, ...]:
@@ -380,12 +284,7 @@ class LandmarkTree:
     def viewframe(self, index: int, *, cached: bool = True) -> Viewframe:
         """The landmarks of viewframe ``index`` (negative: from the goal), stacked for matching."""
         index = range(self.viewframe_count)[index]
-        if not cached:
-            return self._build_viewframe(index)
-        found = self._cache.get(index)
-        if found is None:
-            found = self._cache[index] = self._build_viewframe(index)
-        return found
+        return self._cache.get(index, self._build_viewframe) if cached else self._build_viewframe(index)
 
     def match(self, index: int, observation: Observation, *, bearings: np.ndarray | None = None,
               ratio: float | None = None, cached: bool = True) -> LandmarkMatches:
@@ -393,28 +292,13 @@ class LandmarkTree:
         the observation's (``bearings`` replaces them, e.g. compensated), ``landmark`` indexes the
         viewframe (``viewframe(index).landmarks[m.landmark]`` are map indices). ``cached=False``
         builds the viewframe's stack again (only to measure what the cache saves)."""
-        found = self.viewframe(index, cached=cached)
         cur = np.asarray(observation.bearings if bearings is None else bearings, dtype=np.float64).reshape(-1, 3)
-        if found.ids is not None:
-            if observation.ids is None:
-                raise ValueError("this map holds landmark ids; the observation has descriptors")
-            return _match_ids(np.asarray(observation.ids), found.ids, cur, found.bearings)
-        if observation.features is None or found.matchable is None:
-            raise ValueError(f"this map holds {self.kind} descriptors; the observation has landmark ids")
-        return match_landmarks(observation.features, cur, found.matchable, ratio=ratio)
+        return match_viewframe(self.viewframe(index, cached=cached), observation, cur, kind=self.kind, ratio=ratio)
 
     def _build_viewframe(self, index: int) -> Viewframe:
         landmarks = np.flatnonzero(np.isin(self._rows.node, self.branch_nodes(index)))
-        if self.kind == IDS:  # one row per id: the deepest (most local) copy, sorted by id
-            depth = self.depths()[self._rows.node[landmarks]]
-            order = np.lexsort((-depth, self._rows.data[landmarks]))
-            _, first = np.unique(self._rows.data[landmarks[order]], return_index=True)
-            landmarks = landmarks[order[first]]
-        bearings = _readonly(self._rows.bearings[landmarks].astype(np.float64))
-        data = _readonly(np.ascontiguousarray(self._rows.data[landmarks]))
-        if self.kind == IDS:
-            return Viewframe(index, _readonly(landmarks), bearings, None, data, None)
-        return Viewframe(index, _readonly(landmarks), bearings, data, None, Landmarks(data, bearings, self.kind))
+        depth = self.depths()[self._rows.node[landmarks]] if self.kind == IDS else None
+        return stack_viewframe(index, self.kind, landmarks, self._rows.bearings, self._rows.data, depth)
 
     # ----- learning ---------------------------------------------------------------------------
 
@@ -511,29 +395,19 @@ class LandmarkTree:
     # ----- pruning ----------------------------------------------------------------------------
 
     def prune_level(self, min_landmarks: int = DEFAULT_MIN_LANDMARKS) -> PruneStep | None:
-        """Cut the lowest level (see the module doc); None when there is one level only."""
+        """Cut the lowest level (see :mod:`maps.ltmap.prune`); None when there is one level only."""
         if min_landmarks < 0:
             raise ValueError(f"min_landmarks must be >= 0, got {min_landmarks}")
         if self.height == 0:
             return None
         before = (self.height, self.memory_bytes(), self.landmark_count)
-        parent = np.array(self._parent, dtype=np.int64)
-        node = self._rows.node.copy()
-        for terminal in {self._leaves[0], self._leaves[-1]}:  # start and goal keep their landmarks
-            node[node == terminal] = parent[terminal]
-        keep = ~np.isin(node, self._leaves)
-        old_ends = [int(parent[leaf]) for leaf in self._leaves]
-        ends = list(dict.fromkeys(old_ends))  # same end: one viewframe
-        merged = len(self._leaves) - len(ends)
-        counts = np.bincount(node[keep], minlength=len(parent))
-        sizes = _branch_sizes(parent, counts, ends)
-        weak = {k for k in range(1, len(ends) - 1) if sizes[k] < min_landmarks}
-        candidates = [e for k, e in enumerate(ends) if k not in weak]
-        ends, identical = _merge_identical(parent, counts, candidates)
-        viewframes = _viewframe_index(parent, counts, old_ends, candidates, ends)
-        index = self._restructure(parent, node, keep, ends)
+        cut = cut_lowest_level(self._parent, self._leaves, self._rows.node, min_landmarks)
+        self._parent, self._leaves = cut.node_parent, cut.viewframe_leaves
+        self._rows = self._rows.take(cut.keep)
+        self._rows.node = cut.landmark_nodes
+        self._cache.clear()
         return PruneStep(before[0], self.height, before[1], self.memory_bytes(), before[2] - self.landmark_count,
-                         merged + identical, len(weak), index, viewframes)
+                         cut.merged, cut.deleted, cut.landmark_index, cut.viewframe_index)
 
     def prune_to(self, budget_bytes: int, min_landmarks: int = DEFAULT_MIN_LANDMARKS) -> PruneReport:
         """Cut levels until :meth:`memory_bytes` <= ``budget_bytes``; the map is unchanged when it cannot."""
@@ -548,38 +422,12 @@ class LandmarkTree:
                 return PruneReport(budget_bytes, False, before, before, work.memory_bytes(), tuple(steps),
                                    np.arange(self.landmark_count), np.arange(self.viewframe_count))
             steps.append(step)
-            index = np.where(index >= 0, step.landmark_index[np.maximum(index, 0)], -1)
-            viewframes = np.where(viewframes >= 0, step.viewframe_index[np.maximum(viewframes, 0)], -1)
+            index, viewframes = follow(index, step.landmark_index), follow(viewframes, step.viewframe_index)
         if steps:
             self._parent, self._leaves, self._rows = work._parent, work._leaves, work._rows
             self._cache.clear()
         after = self.memory_bytes()
         return PruneReport(budget_bytes, True, before, after, after, tuple(steps), index, viewframes)
-
-    def _restructure(self, parent: np.ndarray, node: np.ndarray, keep: np.ndarray, ends: list[int]) -> np.ndarray:
-        """Keep the nodes some viewframe passes through, merge a single-child root, renumber the
-        nodes canonically; landmarks keep their order. Returns the new index of each old landmark."""
-        alive = np.zeros(len(parent), dtype=bool)
-        for end in ends:
-            n = end
-            while n >= 0 and not alive[n]:
-                alive[n] = True
-                n = parent[n]
-        keep = keep & alive[node]
-        root = int(np.flatnonzero(alive & (parent < 0))[0])
-        while np.count_nonzero(alive & (parent == root)) == 1:  # a root with one child merges into it
-            child = int(np.flatnonzero(alive & (parent == root))[0])
-            node = np.where(node == root, child, node)
-            alive[root], parent[child], root = False, -1, child
-        order = _preorder(parent, alive, ends)
-        renumber = np.full(len(parent), -1, dtype=np.int64)
-        renumber[order] = np.arange(len(order))
-        self._parent = [int(renumber[parent[n]]) if parent[n] >= 0 else -1 for n in order]
-        self._leaves = [int(renumber[e]) for e in ends]
-        self._rows = self._rows.take(keep)
-        self._rows.node = renumber[node[keep]]
-        self._cache.clear()
-        return np.where(keep, np.cumsum(keep) - 1, -1)
 
     def copy(self) -> LandmarkTree:
         """An independent copy (its own arrays and cache)."""
@@ -595,13 +443,13 @@ class LandmarkTree:
         float32), ``node_parent`` and ``node_size`` (M, int32; the root's parent is -1),
         ``viewframe_leaf`` (V, int32, route order). Equal maps give equal arrays."""
         parent = np.array(self._parent, dtype=np.int64)
-        order = _preorder(parent, np.ones(len(parent), dtype=bool), self._leaves)
+        order = preorder(parent, np.ones(len(parent), dtype=bool), self._leaves)
         renumber = np.full(len(parent), -1, dtype=np.int64)
         renumber[order] = np.arange(len(order))
         node = renumber[self._rows.node]
         grouped = np.argsort(node, kind="stable")
         return {
-            (IDS if self.kind == IDS else "descriptors"): self._rows.data[grouped],
+            data_name(self.kind): self._rows.data[grouped],
             "bearings": np.ascontiguousarray(self._rows.bearings[grouped], dtype=BEARING_DTYPE),
             "node_parent": np.array([renumber[parent[n]] if parent[n] >= 0 else -1 for n in order],
                                     dtype=INDEX_DTYPE).reshape(-1),
@@ -614,348 +462,9 @@ class LandmarkTree:
                     ) -> LandmarkTree:
         """The map :meth:`to_arrays` describes; ``ValueError`` naming the first inconsistency."""
         tree = cls(kind, threshold=threshold)
-        data_name = IDS if kind == IDS else "descriptors"
-        unknown = sorted(set(arrays) - {data_name, *STRUCTURE_ARRAYS})
-        if unknown:
-            raise ValueError(f"unexpected arrays for a {kind} map: {', '.join(unknown)}")
-        data = _checked_data(arrays, kind)
-        bearings = _checked_bearings(arrays, len(data))
-        parent, size, leaves = _checked_structure(arrays, len(data))
-        node = np.repeat(np.arange(len(parent), dtype=np.int64), size)
-        tree._parent, tree._leaves = [int(p) for p in parent], [int(v) for v in leaves]
-        tree._rows = _Rows(node, bearings, data)
+        checked = checked_arrays(arrays, kind)
+        node = np.repeat(np.arange(len(checked.node_parent), dtype=np.int64), checked.node_size)
+        tree._parent, tree._leaves = [int(p) for p in checked.node_parent], [int(v) for v in checked.viewframe_leaf]
+        tree._rows = _Rows(node, checked.bearings, checked.data)
         return tree
 
-
-def _empty_rows(kind: str) -> _Rows:
-    node = np.zeros(0, dtype=np.int64)
-    bearings = np.zeros((0, 3), dtype=BEARING_DTYPE)
-    if kind == IDS:
-        return _Rows(node, bearings, np.zeros(0, dtype=ID_DTYPE))
-    width, dtype = DESCRIPTOR_KINDS[kind]
-    return _Rows(node, bearings, np.zeros((0, width), dtype=dtype))
-
-
-def _match_ids(ids: np.ndarray, stored: np.ndarray, cur: np.ndarray, ref: np.ndarray) -> LandmarkMatches:
-    """Correspondences by equal ids (the ideal sensor): observed ``ids`` with bearings ``cur``
-    against ``stored`` ids with bearings ``ref``."""
-    _, feature, landmark = np.intersect1d(ids, stored, return_indices=True)
-    feature, landmark = feature.astype(np.int64), landmark.astype(np.int64)
-    return LandmarkMatches(ref=ref[landmark], cur=cur[feature], feature=feature, landmark=landmark,
-                           distance=np.zeros(len(feature)))
-
-
-def _branch_sizes(parent: np.ndarray, counts: np.ndarray, ends: Sequence[int]) -> list[int]:
-    sizes = []
-    for end in ends:
-        total, n = 0, end
-        while n >= 0:
-            total += int(counts[n])
-            n = parent[n]
-        sizes.append(total)
-    return sizes
-
-
-def _merge_identical(parent: np.ndarray, counts: np.ndarray, ends: Sequence[int]) -> tuple[list[int], int]:
-    """Keep the first of viewframes whose non-empty nodes are the same (their landmark sets are equal)."""
-    kept: dict[tuple[int, ...], int] = {}
-    for end in ends:
-        kept.setdefault(_signature(parent, counts, end), end)
-    return list(kept.values()), len(ends) - len(kept)
-
-
-def _signature(parent: np.ndarray, counts: np.ndarray, end: int) -> tuple[int, ...]:
-    """The non-empty nodes of the branch ending in ``end`` (equal signatures: equal landmark sets)."""
-    signature, n = [], end
-    while n >= 0:
-        if counts[n]:
-            signature.append(int(n))
-        n = parent[n]
-    return tuple(signature)
-
-
-def _viewframe_index(parent: np.ndarray, counts: np.ndarray, old_ends: Sequence[int], candidates: Sequence[int],
-                     ends: Sequence[int]) -> np.ndarray:
-    """Per old viewframe (its branch now ending in ``old_ends[v]``), the index among the kept ``ends``
-    of the viewframe it became (the one with its landmark set), or -1 when it was deleted (its end
-    is not among the ``candidates`` that survived the landmark minimum)."""
-    kept = {_signature(parent, counts, end): k for k, end in enumerate(ends)}
-    survivors = set(candidates)
-    return np.array([kept[_signature(parent, counts, end)] if end in survivors else -1 for end in old_ends],
-                    dtype=np.int64).reshape(-1)
-
-
-def _preorder(parent: np.ndarray, alive: np.ndarray, ends: Sequence[int]) -> list[int]:
-    """The alive nodes in preorder, children ordered by the first viewframe below them."""
-    first = np.full(len(parent), len(ends), dtype=np.int64)
-    for k in range(len(ends) - 1, -1, -1):
-        n = ends[k]
-        while n >= 0:
-            first[n] = k
-            n = parent[n]
-    children: dict[int, list[int]] = {}
-    roots: list[int] = []
-    for n in np.flatnonzero(alive).tolist():
-        (roots if parent[n] < 0 else children.setdefault(int(parent[n]), [])).append(n)
-    order: list[int] = []
-    stack = sorted(roots, key=lambda n: -int(first[n]))
-    while stack:
-        node = stack.pop()
-        order.append(node)
-        stack.extend(sorted(children.get(node, ()), key=lambda c: -int(first[c])))
-    return order
-
-
-def _checked_data(arrays: Mapping[str, np.ndarray], kind: str) -> np.ndarray:
-    if kind == IDS:
-        ids = _required(arrays, IDS)
-        if ids.ndim != 1 or ids.dtype != ID_DTYPE:
-            raise ValueError(f"ids must be a 1-d int64 array, got {ids.dtype} {ids.shape}")
-        return ids.copy()
-    descriptors = _required(arrays, "descriptors")
-    width, dtype = DESCRIPTOR_KINDS[kind]
-    if descriptors.ndim != 2 or descriptors.shape[1] != width or descriptors.dtype != dtype:
-        raise ValueError(f"{kind} descriptors must be N x {width} {np.dtype(dtype)}, got {descriptors.dtype} "
-                         f"{descriptors.shape}")
-    return np.ascontiguousarray(descriptors).copy()
-
-
-def _checked_bearings(arrays: Mapping[str, np.ndarray], count: int) -> np.ndarray:
-    bearings = _required(arrays, "bearings")
-    if bearings.shape != (count, 3) or bearings.dtype != BEARING_DTYPE:
-        raise ValueError(f"bearings must be {count} x 3 float32 (one per landmark), got {bearings.dtype} "
-                         f"{bearings.shape}")
-    if not np.all(np.isfinite(bearings)) or np.any(np.abs(np.linalg.norm(bearings, axis=1) - 1.0) > 1e-3):
-        raise ValueError("bearings must be finite unit vectors")
-    return bearings.copy()
-
-
-def _checked_structure(arrays: Mapping[str, np.ndarray], count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    parent, size, leaves = (_required(arrays, name) for name in ("node_parent", "node_size", "viewframe_leaf"))
-    for name, array in (("node_parent", parent), ("node_size", size), ("viewframe_leaf", leaves)):
-        if array.ndim != 1 or array.dtype != INDEX_DTYPE:
-            raise ValueError(f"{name} must be a 1-d int32 array, got {array.dtype} {array.shape}")
-    if len(size) != len(parent) or np.any(size < 0) or int(size.sum(dtype=np.int64)) != count:
-        raise ValueError("node_size must give each node's landmark count (one per node, summing to the landmarks)")
-    if len(parent) == 0:
-        if len(leaves):
-            raise ValueError("viewframes need nodes")
-        return parent, size, leaves
-    if parent[0] != -1 or np.any(parent[1:] < 0) or np.any(parent[1:] >= np.arange(1, len(parent))):
-        raise ValueError("node_parent must list the root first and every parent before its children")
-    _check_leaves(parent, leaves)
-    return parent, size, leaves
-
-
-def _check_leaves(parent: np.ndarray, leaves: np.ndarray) -> None:
-    has_child = np.zeros(len(parent), dtype=bool)
-    has_child[parent[1:]] = True
-    actual = np.flatnonzero(~has_child)
-    if len(np.unique(leaves)) != len(leaves) or not np.array_equal(np.sort(leaves), actual):
-        raise ValueError("viewframe_leaf must name every leaf node once")
-    depth = np.zeros(len(parent), dtype=np.int64)
-    for n in range(1, len(parent)):
-        depth[n] = depth[parent[n]] + 1
-    if len(np.unique(depth[actual])) > 1:
-        raise ValueError("every leaf must be at the same depth")
-
-
-def _required(arrays: Mapping[str, np.ndarray], name: str) -> np.ndarray:
-    if name not in arrays:
-        raise ValueError(f"the array {name!r} is missing")
-    return np.asarray(arrays[name])
-
-
-# ----- teaching a route -----------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class LearnConfig:
-    """How a route is taught: the eq. 1 ``threshold`` (rad^2) and Pseudo-Huber ``scale`` (rad), the
-    ``share_angle`` (rad) within which a tracked landmark keeps its stored bearing and is shared
-    (None: the angle whose eq. 1 cost is the threshold), the matching ``ratio`` (None: the kind's
-    default), an optional memory budget (bytes, pruned online) and the smallest viewframe
-    pruning keeps."""
-
-    threshold: float = DEFAULT_THRESHOLD
-    scale: float = DEFAULT_SCALE
-    share_angle: float | None = None
-    ratio: float | None = None
-    budget_bytes: int | None = None
-    min_landmarks: int = DEFAULT_MIN_LANDMARKS
-
-    def __post_init__(self) -> None:
-        for name in ("threshold", "scale", "share_angle"):
-            value = getattr(self, name)
-            if value is not None and not (np.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive number, got {value}")
-        if self.budget_bytes is not None and self.budget_bytes <= 0:
-            raise ValueError(f"budget_bytes must be positive, got {self.budget_bytes}")
-        if self.min_landmarks < 0:
-            raise ValueError(f"min_landmarks must be >= 0, got {self.min_landmarks}")
-
-
-def threshold_angle(threshold: float, scale: float = DEFAULT_SCALE) -> float:
-    """The bearing change (rad) whose eq. 1 cost is ``threshold``: the inverse of the Pseudo-Huber cost."""
-    return float(scale * np.sqrt((1.0 + threshold / scale**2) ** 2 - 1.0))
-
-
-@dataclass(frozen=True, slots=True)
-class LearnStep:
-    """What one observation did to the map while teaching.
-
-    ``viewframe``: index of the last viewframe (-1 before the first); ``created``: this observation
-    made it; ``delta_t``: eq. 1 since the previous viewframe (``inf`` when nothing was tracked or
-    there was none); ``tracked``: landmarks of the previous viewframe seen now; ``stored``:
-    landmarks stored in the new leaf (new ones and sightings not shared); ``volatile``: features
-    rejected because the previous image lacked them; ``pruned``: the online pruning this step
-    ran (a budget is set and was exceeded).
-    """
-
-    viewframe: int
-    created: bool
-    delta_t: float
-    tracked: int
-    stored: int = 0
-    volatile: int = 0
-    pruned: PruneReport | None = None
-
-    @property
-    def over_budget(self) -> bool:
-        """Online pruning could not bring the map under the budget."""
-        return self.pruned is not None and not self.pruned.fits
-
-
-@dataclass(frozen=True, slots=True)
-class _Seen:
-    observation: Observation
-    bearings: np.ndarray  # route frame
-
-
-@dataclass(frozen=True, slots=True)
-class _Tracked:
-    """An observation matched against the last viewframe: map indices and current bearings."""
-
-    matches: LandmarkMatches
-    landmarks: np.ndarray
-
-
-@dataclass
-class _Anchor:
-    """The landmarks seen when the last viewframe was made, with their bearings then (eq. 1's reference)."""
-
-    landmarks: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    bearings: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
-
-
-class RouteLearner:
-    """Teaches an LT-map: feed it every new observation with the camera heading (algorithm 1).
-
-    ``observe`` matches the observation against the last viewframe (cached), computes ``delta_t``
-    (eq. 1) of the landmarks tracked since that viewframe and, past the threshold, appends a
-    viewframe; ``finish`` makes the last place (the goal) a viewframe. With
-    ``config.budget_bytes`` the map is pruned online whenever it outgrows the budget, so the
-    route length need not be known in advance. ``tree`` is None until the first observation,
-    whose kind (descriptors or ids) the map takes.
-    """
-
-    def __init__(self, config: LearnConfig | None = None) -> None:
-        self.config = config or LearnConfig()
-        self.tree: LandmarkTree | None = None
-        self._latest: _Seen | None = None
-        self._before: _Seen | None = None
-        self._at_viewframe = False
-        self._anchor = _Anchor()
-        angle = self.config.share_angle
-        self.share_angle = threshold_angle(self.config.threshold, self.config.scale) if angle is None else angle
-
-    def observe(self, observation: Observation, heading: float) -> LearnStep:
-        """One new observation, seen with the camera at ``heading`` (rad) in the route frame."""
-        if self.tree is None:
-            self.tree = LandmarkTree(_kind_of(observation), threshold=self.config.threshold)
-        tree, seen = self.tree, _Seen(observation, compensate(observation.bearings, heading))
-        self._before, self._latest = self._latest, seen
-        if tree.viewframe_count == 0:
-            self._at_viewframe = self._before is not None  # the first viewframe needs a previous image
-            if not self._at_viewframe:
-                return LearnStep(-1, False, np.inf, 0)
-            return self._make_viewframe(tree, seen, np.inf, 0)
-        tracked = self._track(tree, seen)
-        change, count = self._change(tracked)
-        self._at_viewframe = change > self.config.threshold
-        if self._at_viewframe:
-            return self._make_viewframe(tree, seen, change, count, tracked)
-        return LearnStep(tree.viewframe_count - 1, False, change, count)
-
-    def finish(self) -> LearnStep:
-        """Make the latest observation's place the last viewframe (the goal), unless it already is."""
-        tree, seen = self.tree, self._latest
-        if seen is None or tree is None:
-            raise ValueError("nothing was observed: there is no route to finish")
-        if self._at_viewframe:
-            return LearnStep(tree.viewframe_count - 1, False, 0.0, 0)
-        self._at_viewframe = True
-        if tree.viewframe_count == 0:
-            return self._make_viewframe(tree, seen, np.inf, 0)
-        tracked = self._track(tree, seen)
-        return self._make_viewframe(tree, seen, *self._change(tracked), tracked)
-
-    def _track(self, tree: LandmarkTree, seen: _Seen) -> _Tracked:
-        matches = tree.match(-1, seen.observation, bearings=seen.bearings, ratio=self.config.ratio)
-        return _Tracked(matches, tree.viewframe(-1).landmarks[matches.landmark])
-
-    def _change(self, tracked: _Tracked) -> tuple[float, int]:
-        """Eq. 1 over the landmarks tracked since the last viewframe, from their bearings then."""
-        _, then, now = np.intersect1d(self._anchor.landmarks, tracked.landmarks, return_indices=True)
-        change = delta_t(self._anchor.bearings[then], tracked.matches.cur[now], scale=self.config.scale)  # eq. 1
-        return change, len(then)
-
-    def _make_viewframe(self, tree: LandmarkTree, seen: _Seen, change: float, count: int,
-                        tracked: _Tracked | None = None) -> LearnStep:
-        stable = self._stable(seen)
-        landmarks, features = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-        if tracked is not None:
-            landmarks, features = tracked.landmarks, tracked.matches.feature
-        new = np.setdiff1d(stable, features)
-        volatile = seen.observation.count - len(stable)
-        if len(new) == 0 and len(landmarks) == 0:  # nothing seen (a blind spell): no empty viewframes
-            self._at_viewframe = False
-            return LearnStep(tree.viewframe_count - 1, False, float(change), count, volatile=volatile)
-        before = tree.landmark_count
-        sightings = LandmarkSet.from_observation(seen.observation, seen.bearings, features)
-        tree.add_viewframe(landmarks, sightings, LandmarkSet.from_observation(seen.observation, seen.bearings, new),
-                           share_angle=self.share_angle)
-        stored = np.arange(before, tree.landmark_count)
-        self._anchor = _Anchor(np.concatenate((landmarks, stored)),
-                               np.vstack((sightings.bearings, tree.bearings[stored])))
-        pruned = self._prune_online(tree)
-        return LearnStep(tree.viewframe_count - 1, True, float(change), count, len(stored), volatile, pruned)
-
-    def _prune_online(self, tree: LandmarkTree) -> PruneReport | None:
-        budget = self.config.budget_bytes
-        if budget is None or tree.memory_bytes() <= budget:
-            return None
-        report = tree.prune_to(budget, self.config.min_landmarks)
-        index = report.landmark_index[self._anchor.landmarks]
-        self._anchor = _Anchor(index[index >= 0], self._anchor.bearings[index >= 0])
-        return report
-
-    def _stable(self, seen: _Seen) -> np.ndarray:
-        """Indices of the observation's landmarks also seen in the previous image (not volatile)."""
-        cur = seen.observation
-        if self._before is None:
-            return np.arange(cur.count)
-        previous = self._before.observation
-        if cur.ids is not None and previous.ids is not None:
-            return np.sort(np.intersect1d(cur.ids, previous.ids, return_indices=True)[1]).astype(np.int64)
-        if cur.features is not None and previous.features is not None:
-            return np.sort(match_features(cur.features, previous.features, ratio=self.config.ratio).query)
-        raise ValueError("observations mix landmark ids and descriptors")
-
-
-def _kind_of(observation: Observation) -> str:
-    if observation.ids is not None:
-        return IDS
-    if observation.features is None:
-        raise ValueError("the observation has neither descriptors nor ids")
-    return observation.features.kind

@@ -14,7 +14,7 @@ import math
 import re
 
 from maps.ltmap.file import load_ltmap, save_ltmap
-from maps.ltmap.tree import DEFAULT_MIN_LANDMARKS
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
 from maps.store import InputError
 from missions.commands.common import EXIT_INVALID, EXIT_OK, fail
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from maps.ltmap.file import KIND, decode_ltmap, encode_ltmap, load_ltmap, save_ltmap
-from maps.ltmap.tree import RouteLearner
+from maps.ltmap.learner import RouteLearner
 from maps.mapfile import encode_map
 from maps.store import InputError
 from perception.synthetic_route import make_route_world, observe_route, straight_route
