@@ -1,7 +1,8 @@
 """Route following on an LT-map: home to one viewframe after another (DESIGN.md, algorithm 1).
 
 Three nodes share the work, composed in a mission (``follow_route.yaml``) with the control
-nodes rather than in one behaviour:
+nodes rather than in one behaviour; what they compute about a viewframe is perception's
+(:mod:`perception.viewframe_motion`):
 
 - :class:`StartRoute` writes the :class:`RouteProgress` (``/map/route_progress``): direction
   (forward along the route, or reverse, back to its start) and the first target viewframe.
@@ -30,11 +31,11 @@ How the paper is read here (where it is vague):
   error, and zero while the error exceeds ``turn_in_place``. The floor keeps the robot moving
   near a viewframe, where the translation is short and the confidence low, until the switch
   rule fires.
-- **Lost.** "Fewer than 50 landmarks match" is read as fewer than ``min_matches``, or than half
-  the viewframe's landmarks when it holds fewer than ``2 * min_matches`` (a map of the
-  simulator's ideal sensor in a room of 24 landmarks never reaches 50), but never fewer than
-  Z-infinity's minimum of 8. An observation with no usable estimate (no rotation, or no
-  direction yet) counts as lost too.
+- **Lost.** Fewer matches than :func:`perception.viewframe_motion.lost_threshold` (the paper's
+  50, or half a small viewframe, never under Z-infinity's 8). An observation with no usable
+  estimate (no rotation, or no direction yet) counts as lost too.
+- **Rotation.** Z-infinity down a ladder of far thresholds, with a compass as the last resort
+  (:func:`perception.viewframe_motion.zinf_motion`; the module doc says why).
 - **Goal.** The switch rule fires within some radius of a viewframe (where ``delta_t`` first falls
   under the threshold), which is right for passing through viewframes but leaves the robot short
   of the route's end: the last viewframe is reached under ``goal_fraction`` (a quarter) of the
@@ -54,7 +55,6 @@ from typing import Any
 
 import numpy as np
 from py_trees.common import Status
-from scipy.spatial.transform import Rotation
 
 from behaviours.base import BearingsBehaviour
 from behaviours.landmark_tree import LTMAP_IN
@@ -68,11 +68,10 @@ from perception.heading import HeadingFilter, heading_flipped, scaled_velocity
 from perception.matching import LandmarkMatches
 from perception.observation import Observation
 from perception.similarity import delta_t
-from perception.zinf import ZinfResult, ZinfStatus, estimate_motion, estimate_translation
+from perception.viewframe_motion import ZINF_MIN_LANDMARKS, compass_motion, lost_threshold, zinf_motion
 
 PROGRESS_KEY = "/map/route_progress"
 ESTIMATE_KEY = "/map/route_estimate"
-ZINF_MIN_LANDMARKS = 8  # perception.zinf.estimate_motion's default minimum
 DIRECTIONS = ("forward", "reverse")
 
 
@@ -139,53 +138,6 @@ class RouteEstimate:
     @property
     def usable(self) -> bool:
         return math.isfinite(self.error)
-
-
-def lost_threshold(viewframe_size: int, min_matches: int) -> int:
-    """Fewest matches to follow a viewframe of ``viewframe_size`` landmarks (see the module doc)."""
-    small = viewframe_size < 2 * min_matches
-    return max(ZINF_MIN_LANDMARKS, math.ceil(viewframe_size / 2) if small else min_matches)
-
-
-FAR_THRESHOLDS = tuple(np.radians((1.0, 2.0, 4.0, 8.0)))  # rad: "unmoved after rotation", tightest first
-
-
-def zinf_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> tuple[ZinfResult, bool]:
-    """Z-infinity (eqs. 2-6) with the tightest far threshold that separates a rotation.
-
-    Indoors few landmarks are far enough to move less than 1 degree over the tens of centimetres
-    between viewframes (and the ideal sensor's noise alone moves a bearing by that much): with
-    no far set at 1 degree, the estimate is tried again at 2, 4 and 8 degrees, the farthest
-    landmarks there standing in for the ones at infinity. When none separates a rotation (a
-    pruned viewframe with few landmarks left), the rotation of all matched landmarks (a compass,
-    :func:`compass_motion`) keeps the robot going rather than stopping it. Returns the estimate
-    and whether it is that compass.
-    """
-    motion = estimate_motion(ref, cur, rng=rng, far_threshold=FAR_THRESHOLDS[0])
-    for threshold in FAR_THRESHOLDS[1:]:
-        if motion.status is not ZinfStatus.NO_ROTATION:
-            return motion, False
-        motion = estimate_motion(ref, cur, rng=rng, far_threshold=threshold)
-    if motion.status is ZinfStatus.NO_ROTATION:
-        return compass_motion(ref, cur, rng), True
-    return motion, False
-
-
-def compass_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> ZinfResult:
-    """A visual compass, for comparison only: the rotation fitted to ALL matched landmarks, near
-    ones included (no far/near separation), then the translation as Z-infinity finds it."""
-    ref, cur = np.asarray(ref, dtype=np.float64), np.asarray(cur, dtype=np.float64)
-    none = np.zeros(len(ref), dtype=bool)
-    if len(ref) < ZINF_MIN_LANDMARKS:
-        return ZinfResult(np.eye(3), np.zeros(3), none, none, 0.0, ZinfStatus.NOT_ENOUGH_LANDMARKS)
-    rotation = Rotation.align_vectors(cur, ref)[0].as_matrix()
-    everything = np.ones(len(ref), dtype=bool)
-    moved = estimate_translation(ref, cur @ rotation, np.ones(len(ref)), rng=rng, threshold=np.radians(1.0),
-                                 iterations=200, min_near=5)
-    if moved is None:
-        return ZinfResult(rotation, np.zeros(3), everything, everything, 0.0, ZinfStatus.NO_TRANSLATION)
-    t, inliers, confidence = moved
-    return ZinfResult(rotation, t, everything, inliers, confidence, ZinfStatus.OK)
 
 
 @register

@@ -15,16 +15,12 @@ from behaviours.route import (
     RouteProgress,
     StartRoute,
     ViewframeSwitch,
-    compass_motion,
-    lost_threshold,
-    zinf_motion,
 )
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP
 from perception.geometry import Pose2D
 from perception.observation import Observation
-from perception.synthetic_route import observe_route
-from tests.behaviours.routes import WORLD, IdealBase, taught_map
+from tests.behaviours.routes import IdealBase, taught_map
 
 TREE, PLACES = taught_map()
 
@@ -44,12 +40,6 @@ def test_progress_advances_and_finishes():
     progress = progress.advanced(1.0).advanced(2.0)
     assert (progress.target, progress.switches, progress.switched_at, progress.remaining) == (0, 2, 2.0, 1)
     assert progress.advanced(3.0).finished
-
-
-def test_lost_threshold_is_the_papers_50_unless_the_viewframe_is_small():
-    assert lost_threshold(400, 50) == 50
-    assert lost_threshold(24, 50) == 12  # the ideal sensor in a room: half the viewframe
-    assert lost_threshold(6, 50) == 8  # never under Z-infinity's minimum
 
 
 def follow_harness(pose: Pose2D, target: int, **ports) -> BehaviourHarness:
@@ -189,16 +179,3 @@ def test_following_the_whole_route_reaches_its_end(direction):
     assert base.pose.distance_to(goal) < 0.1
     assert max(abs(p.y) for p in base.trail) < 0.1  # along the taught line
     assert harness.read("/map/route_progress").switches == TREE.viewframe_count
-
-
-def test_zinf_keeps_the_rotation_where_a_compass_of_near_landmarks_is_pulled_off():
-    rng = np.random.default_rng(3)
-    place = PLACES[len(PLACES) // 2]
-    ref = observe_route(WORLD, place, rng)
-    cur = observe_route(WORLD, Pose2D(place.x + 0.3, place.y + 0.3, 0.5), rng)
-    _, a, b = np.intersect1d(ref.ids, cur.ids, return_indices=True)
-    zinf, fallback = zinf_motion(ref.bearings[a], cur.bearings[b], rng)
-    assert not fallback
-    compass = compass_motion(ref.bearings[a], cur.bearings[b], rng)
-    assert abs(zinf.yaw + 0.5) < math.radians(0.5)
-    assert abs(compass.yaw + 0.5) > abs(zinf.yaw + 0.5)
