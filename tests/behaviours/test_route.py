@@ -9,13 +9,8 @@ import pytest
 from py_trees.common import Status
 
 from behaviours.control import Parallel
-from behaviours.route import (
-    FollowRoute,
-    RouteEstimate,
-    RouteProgress,
-    StartRoute,
-    ViewframeSwitch,
-)
+from behaviours.route import FollowRoute, RouteEstimate, RouteProgress, StartRoute, ViewframeSwitch
+from behaviours.telemetry import Arrows, Event, Plot, Points, report_sections
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP
 from perception.geometry import Pose2D
@@ -122,8 +117,8 @@ def test_switch_moves_on_when_delta_t_falls_under_the_threshold():
     assert harness.tick() == Status.RUNNING
     progress = harness.read("/map/route_progress")
     assert (progress.target, progress.switches, progress.switched_at) == (3, 1, 1.5)
-    reached = harness.behaviour.report_sections()["ltmap"]["reached"]
-    assert reached == [{"viewframe": 2, "time_s": 1.5, "rule": "delta_t"}]
+    assert report_sections(harness.behaviour) == {"ltmap": {
+        "switches": 1, "switches_by_flip": 0, "reached": [{"viewframe": 2, "time_s": 1.5, "rule": "delta_t"}]}}
 
 
 def test_flip_rule_is_blocked_for_a_half_turn_after_a_switch():
@@ -140,7 +135,7 @@ def test_flip_rule_is_blocked_for_a_half_turn_after_a_switch():
         harness.write("/map/route_estimate", estimate(2, t, near, heading))
         harness.tick()
     assert harness.read("/map/route_progress").target == 3
-    assert harness.behaviour.report_sections()["ltmap"]["switches_by_flip"] == 1
+    assert report_sections(harness.behaviour)["ltmap"]["switches_by_flip"] == 1
 
 
 def test_a_flip_far_from_the_viewframe_is_noise():
@@ -179,3 +174,33 @@ def test_following_the_whole_route_reaches_its_end(direction):
     assert base.pose.distance_to(goal) < 0.1
     assert max(abs(p.y) for p in base.trail) < 0.1  # along the taught line
     assert harness.read("/map/route_progress").switches == TREE.viewframe_count
+
+
+def test_follow_route_draws_its_estimate_while_it_follows():
+    target = len(PLACES) // 2
+    harness = follow_harness(Pose2D(), target, k=1)
+    IdealBase(harness, Pose2D(PLACES[target].x - 0.4, 0.0, 0.0))
+    node = harness.behaviour
+    assert list(node.drawings()) == []  # nothing estimated yet
+    harness.tick()
+    drawn = {d.entity: d for d in node.drawings()}
+    estimate = harness.read("/map/route_estimate")
+    assert drawn["route/target_viewframe"] == Plot("route/target_viewframe", float(target))
+    assert drawn["route/matched"].value == estimate.matched and drawn["route/delta_t"].value <= 1.0
+    arrow = drawn["route/robot_frame/direction"]
+    assert isinstance(arrow, Arrows) and arrow.colours == (255, 80, 0)
+    assert np.allclose(arrow.vectors, [[math.cos(estimate.error), math.sin(estimate.error)]])
+    matched = drawn["route/robot_frame/matched_landmarks"]
+    assert isinstance(matched, Points) and len(matched.positions) == estimate.matched and matched.radius == 0.02
+    assert report_sections(node) == {}  # following adds nothing to the report
+
+
+def test_switch_draws_each_switch_once():
+    harness = switch_harness(RouteProgress(1, 2, 5, 0.0))
+    harness.write("/robot/odometry", Pose2D(1.0, 0.5, 0.0))
+    harness.write("/map/route_estimate", estimate(2, 1.0, TREE.threshold / 2))
+    harness.tick()
+    drawn = list(harness.behaviour.drawings())
+    assert drawn[0] == Event("route/events", "viewframe 2 reached (delta_t)")
+    assert drawn[1].entity == "odometry_frame/route/reached_viewframes" and drawn[1].positions.tolist() == [[1.0, 0.5]]
+    assert list(harness.behaviour.drawings()) == []  # nothing new: nothing drawn
