@@ -1,12 +1,12 @@
 """The LT-map on the blackboard: load it from a file, prune it to a memory budget.
 
-The map of a taught route (:class:`maps.ltmap.LandmarkTree`, DESIGN.md algorithm 1) travels
+The map of a taught route (:class:`maps.ltmap.tree.LandmarkTree`, DESIGN.md algorithm 1) travels
 between nodes on ``/map/ltmap``: ``LearnRoute`` (:mod:`behaviours.teach`) or :class:`LoadMap`
 write it, :class:`PruneMap` shrinks it, the route-following nodes (:mod:`behaviours.route`,
 :mod:`behaviours.search`) read it. The file path is a literal port, so missions pass it as an
 input (``path: "${map}"``) and ``--set map=...`` picks another file.
 
-Both nodes add to the report's ``ltmap`` section (:meth:`report_sections`): the map's shape and
+Both nodes add to the report's ``ltmap`` section (their ``figures``): the map's shape and
 size, and for a pruned map the memory it kept and where each of its viewframes came from
 (``viewframe_source``: the index in the loaded map), so an evaluation can compare a viewframe
 reached while following a pruned map with the place it was taught.
@@ -15,6 +15,7 @@ reached while following a pruned map with the place it was taught.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -23,8 +24,10 @@ from py_trees.common import Status
 from behaviours.base import BearingsBehaviour
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
-from maps.ltmap import DEFAULT_MIN_LANDMARKS, LandmarkTree, MapSummary
-from maps.ltmap_file import load_ltmap, save_ltmap
+from behaviours.telemetry import Figure, section
+from maps.ltmap.file import load_ltmap, save_ltmap
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
+from maps.ltmap.tree import LandmarkTree, MapSummary
 from maps.store import InputError
 
 LTMAP_KEY = "/map/ltmap"
@@ -59,17 +62,15 @@ class LoadMap(BearingsBehaviour):
     the file is checked whole (version, checksum, tree consistency) before anything follows it.
     """
 
-    PORTS = (
-        InputPort("path", str, doc="the LT-map file (a mission input: --set map=route.ltmap)", literal_only=True),
-        LTMAP_OUT,
-    )
+    PATH = InputPort("path", str, doc="the LT-map file (a mission input: --set map=route.ltmap)", literal_only=True)
+    PORTS = (PATH, LTMAP_OUT)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
         self.summary: MapSummary | None = None
 
     def update(self) -> Status:
-        path = str(self.get_input("path"))
+        path = self.get_input(self.PATH)
         try:
             tree = load_ltmap(path)
         except (InputError, OSError) as exc:
@@ -79,14 +80,13 @@ class LoadMap(BearingsBehaviour):
             self.feedback_message = f"{path}: the map has no viewframes"
             return Status.FAILURE
         self.summary = tree.summary()
-        self.set_output("ltmap", tree)
+        self.set_output(LTMAP_OUT, tree)
         self.feedback_message = f"{tree.viewframe_count} viewframes, {tree.memory_bytes()} bytes"
         return Status.SUCCESS
 
-    def report_sections(self) -> dict[str, dict[str, Any]]:
-        if self.summary is None:
-            return {}
-        return {"ltmap": {"map_file": str(self.get_input("path")), **summary_section(self.summary)}}
+    def figures(self) -> Iterator[Figure]:
+        if self.summary is not None:
+            yield from section("ltmap", {"map_file": self.get_input(self.PATH), **summary_section(self.summary)})
 
 
 @register
@@ -100,16 +100,14 @@ class PruneMap(BearingsBehaviour):
     saved atomically.
     """
 
-    PORTS = (
-        InputPort("budget", int, 0, unit="B", minimum=0, doc="memory budget in bytes; 0: none"),
-        InputPort("fraction", float, 1.0, minimum=0.0, maximum=1.0,
-                  doc="memory budget as a fraction of the map's size; 1: none"),
-        InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0,
-                  doc="viewframes left with fewer landmarks are deleted (the paper: 50, enough for homing)"),
-        InputPort("path", str, "", literal_only=True, doc="save the pruned map here too (empty: do not save)"),
-        InputPort("source", LandmarkTree, Ref(LTMAP_KEY), doc="the LT-map to prune"),
-        LTMAP_OUT,
-    )
+    BUDGET = InputPort("budget", int, 0, unit="B", minimum=0, doc="memory budget in bytes; 0: none")
+    FRACTION = InputPort("fraction", float, 1.0, minimum=0.0, maximum=1.0,
+                         doc="memory budget as a fraction of the map's size; 1: none")
+    MIN_LANDMARKS = InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0,
+                              doc="viewframes left with fewer landmarks are deleted (the paper: 50, enough for homing)")
+    PATH = InputPort("path", str, "", literal_only=True, doc="save the pruned map here too (empty: do not save)")
+    SOURCE = InputPort("source", LandmarkTree, Ref(LTMAP_KEY), doc="the LT-map to prune")
+    PORTS = (BUDGET, FRACTION, MIN_LANDMARKS, PATH, SOURCE, LTMAP_OUT)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -118,7 +116,7 @@ class PruneMap(BearingsBehaviour):
     def budget_bytes(self, size: int) -> int | None:
         """The budget for a map of ``size`` bytes, or None for no limit."""
         limits = []
-        budget, fraction = int(self.get_input("budget")), float(self.get_input("fraction"))
+        budget, fraction = self.get_input(self.BUDGET), self.get_input(self.FRACTION)
         if budget > 0:
             limits.append(budget)
         if fraction < 1.0:
@@ -126,7 +124,7 @@ class PruneMap(BearingsBehaviour):
         return min(limits) if limits else None
 
     def update(self) -> Status:
-        tree: LandmarkTree | None = self.get_input("source", None)
+        tree = self.get_input(self.SOURCE, None)
         if tree is None:
             self.feedback_message = "no LT-map to prune"
             return Status.FAILURE
@@ -135,16 +133,16 @@ class PruneMap(BearingsBehaviour):
         pruned = tree.copy()  # the input stays as it was for whoever else holds it
         source = np.arange(tree.viewframe_count)
         if budget is not None:
-            report = pruned.prune_to(budget, int(self.get_input("min_landmarks")))
+            report = pruned.prune_to(budget, self.get_input(self.MIN_LANDMARKS))
             if not report.fits:
                 self.feedback_message = f"{report.smallest_bytes} bytes at the least, over the {budget} byte budget"
                 return Status.FAILURE
             source = np.array([int(np.flatnonzero(report.viewframe_index == k)[0])
                                for k in range(pruned.viewframe_count)], dtype=np.int64)
-        path = str(self.get_input("path"))
+        path = self.get_input(self.PATH)
         if path:
             save_map(path, pruned)
-        self.set_output("ltmap", pruned)
+        self.set_output(LTMAP_OUT, pruned)
         after = pruned.memory_bytes()
         self.section = {**summary_section(pruned.summary()), "bytes_before_pruning": before,
                         "memory_fraction": round(after / before, 4) if before else 1.0,
@@ -152,5 +150,5 @@ class PruneMap(BearingsBehaviour):
         self.feedback_message = f"{before} -> {after} bytes, {pruned.viewframe_count} viewframes"
         return Status.SUCCESS
 
-    def report_sections(self) -> dict[str, dict[str, Any]]:
-        return {"ltmap": dict(self.section)} if self.section else {}
+    def figures(self) -> Iterator[Figure]:
+        yield from section("ltmap", self.section)

@@ -1,7 +1,8 @@
 """Route following on an LT-map: home to one viewframe after another (DESIGN.md, algorithm 1).
 
 Three nodes share the work, composed in a mission (``follow_route.yaml``) with the control
-nodes rather than in one behaviour:
+nodes rather than in one behaviour; what they compute about a viewframe is perception's
+(:mod:`perception.viewframe_motion`):
 
 - :class:`StartRoute` writes the :class:`RouteProgress` (``/map/route_progress``): direction
   (forward along the route, or reverse, back to its start) and the first target viewframe.
@@ -30,11 +31,11 @@ How the paper is read here (where it is vague):
   error, and zero while the error exceeds ``turn_in_place``. The floor keeps the robot moving
   near a viewframe, where the translation is short and the confidence low, until the switch
   rule fires.
-- **Lost.** "Fewer than 50 landmarks match" is read as fewer than ``min_matches``, or than half
-  the viewframe's landmarks when it holds fewer than ``2 * min_matches`` (a map of the
-  simulator's ideal sensor in a room of 24 landmarks never reaches 50), but never fewer than
-  Z-infinity's minimum of 8. An observation with no usable estimate (no rotation, or no
-  direction yet) counts as lost too.
+- **Lost.** Fewer matches than :func:`perception.viewframe_motion.lost_threshold` (the paper's
+  50, or half a small viewframe, never under Z-infinity's 8). An observation with no usable
+  estimate (no rotation, or no direction yet) counts as lost too.
+- **Rotation.** Z-infinity down a ladder of far thresholds, with a compass as the last resort
+  (:func:`perception.viewframe_motion.zinf_motion`; the module doc says why).
 - **Goal.** The switch rule fires within some radius of a viewframe (where ``delta_t`` first falls
   under the threshold), which is right for passing through viewframes but leaves the robot short
   of the route's end: the last viewframe is reached under ``goal_fraction`` (a quarter) of the
@@ -49,30 +50,30 @@ How the paper is read here (where it is vague):
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 from py_trees.common import Status
-from scipy.spatial.transform import Rotation
 
 from behaviours.base import BearingsBehaviour
 from behaviours.landmark_tree import LTMAP_IN
 from behaviours.motion import COMMAND, ODOMETRY, STALLED
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
+from behaviours.telemetry import Arrows, Drawing, Event, Figure, Plot, Points
 from drivers.interfaces import STOP, VelocityCommand
-from maps.ltmap import LandmarkTree
+from maps.ltmap.tree import LandmarkTree
 from perception.geometry import wrap_angle
 from perception.heading import HeadingFilter, heading_flipped, scaled_velocity
 from perception.matching import LandmarkMatches
 from perception.observation import Observation
 from perception.similarity import delta_t
-from perception.zinf import ZinfResult, ZinfStatus, estimate_motion, estimate_translation
+from perception.viewframe_motion import ZINF_MIN_LANDMARKS, compass_motion, lost_threshold, zinf_motion
 
 PROGRESS_KEY = "/map/route_progress"
 ESTIMATE_KEY = "/map/route_estimate"
-ZINF_MIN_LANDMARKS = 8  # perception.zinf.estimate_motion's default minimum
 DIRECTIONS = ("forward", "reverse")
 
 
@@ -141,53 +142,6 @@ class RouteEstimate:
         return math.isfinite(self.error)
 
 
-def lost_threshold(viewframe_size: int, min_matches: int) -> int:
-    """Fewest matches to follow a viewframe of ``viewframe_size`` landmarks (see the module doc)."""
-    small = viewframe_size < 2 * min_matches
-    return max(ZINF_MIN_LANDMARKS, math.ceil(viewframe_size / 2) if small else min_matches)
-
-
-FAR_THRESHOLDS = tuple(np.radians((1.0, 2.0, 4.0, 8.0)))  # rad: "unmoved after rotation", tightest first
-
-
-def zinf_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> tuple[ZinfResult, bool]:
-    """Z-infinity (eqs. 2-6) with the tightest far threshold that separates a rotation.
-
-    Indoors few landmarks are far enough to move less than 1 degree over the tens of centimetres
-    between viewframes (and the ideal sensor's noise alone moves a bearing by that much): with
-    no far set at 1 degree, the estimate is tried again at 2, 4 and 8 degrees, the farthest
-    landmarks there standing in for the ones at infinity. When none separates a rotation (a
-    pruned viewframe with few landmarks left), the rotation of all matched landmarks (a compass,
-    :func:`compass_motion`) keeps the robot going rather than stopping it. Returns the estimate
-    and whether it is that compass.
-    """
-    motion = estimate_motion(ref, cur, rng=rng, far_threshold=FAR_THRESHOLDS[0])
-    for threshold in FAR_THRESHOLDS[1:]:
-        if motion.status is not ZinfStatus.NO_ROTATION:
-            return motion, False
-        motion = estimate_motion(ref, cur, rng=rng, far_threshold=threshold)
-    if motion.status is ZinfStatus.NO_ROTATION:
-        return compass_motion(ref, cur, rng), True
-    return motion, False
-
-
-def compass_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> ZinfResult:
-    """A visual compass, for comparison only: the rotation fitted to ALL matched landmarks, near
-    ones included (no far/near separation), then the translation as Z-infinity finds it."""
-    ref, cur = np.asarray(ref, dtype=np.float64), np.asarray(cur, dtype=np.float64)
-    none = np.zeros(len(ref), dtype=bool)
-    if len(ref) < ZINF_MIN_LANDMARKS:
-        return ZinfResult(np.eye(3), np.zeros(3), none, none, 0.0, ZinfStatus.NOT_ENOUGH_LANDMARKS)
-    rotation = Rotation.align_vectors(cur, ref)[0].as_matrix()
-    everything = np.ones(len(ref), dtype=bool)
-    moved = estimate_translation(ref, cur @ rotation, np.ones(len(ref)), rng=rng, threshold=np.radians(1.0),
-                                 iterations=200, min_near=5)
-    if moved is None:
-        return ZinfResult(rotation, np.zeros(3), everything, everything, 0.0, ZinfStatus.NO_TRANSLATION)
-    t, inliers, confidence = moved
-    return ZinfResult(rotation, t, everything, inliers, confidence, ZinfStatus.OK)
-
-
 @register
 class StartRoute(BearingsBehaviour):
     """Start following the LT-map's route: forward from its start, or in reverse back home.
@@ -195,21 +149,20 @@ class StartRoute(BearingsBehaviour):
     Writes the first :class:`RouteProgress`; SUCCESS at once (FAILURE without a map).
     """
 
-    PORTS = (
-        InputPort("direction", str, "forward", choices=DIRECTIONS,
-                  doc="forward: start to goal; reverse: goal back to the start (return home)"),
-        LTMAP_IN,
-        OutputPort("progress", RouteProgress, PROGRESS_KEY, doc="the target viewframe and the switches so far"),
-    )
+    DIRECTION = InputPort("direction", str, "forward", choices=DIRECTIONS,
+                          doc="forward: start to goal; reverse: goal back to the start (return home)")
+    PROGRESS = OutputPort("progress", RouteProgress, PROGRESS_KEY, doc="the target viewframe and the switches so far")
+    PORTS = (DIRECTION, LTMAP_IN, PROGRESS)
 
     def update(self) -> Status:
-        tree: LandmarkTree | None = self.get_input("ltmap", None)
+        tree = self.get_input(LTMAP_IN, None)
         if tree is None or tree.viewframe_count == 0:
             self.feedback_message = "no LT-map to follow"
             return Status.FAILURE
-        direction = 1 if self.get_input("direction") == "forward" else -1
-        self.set_output("progress", RouteProgress.start(tree.viewframe_count, direction, self.now()))
-        self.feedback_message = f"{tree.viewframe_count} viewframes, {self.get_input('direction')}"
+        direction = self.get_input(self.DIRECTION)
+        self.set_output(self.PROGRESS, RouteProgress.start(tree.viewframe_count, 1 if direction == "forward" else -1,
+                                                           self.now()))
+        self.feedback_message = f"{tree.viewframe_count} viewframes, {direction}"
         return Status.SUCCESS
 
 
@@ -233,24 +186,21 @@ class FollowRoute(BearingsBehaviour):
     ``estimate``.
     """
 
-    PORTS = (
-        FOLLOW_SPEED,
-        InputPort("min_speed", float, 0.05, unit="m/s", minimum=0.0, maximum=1.2,
-                  doc="speed floor while the estimate is usable, so a viewframe is always reached"),
-        TURN_RATE,
-        InputPort("heading_gain", float, 1.5, unit="1/s", minimum=0.01, doc="turn rate per rad of heading error"),
-        InputPort("turn_in_place", float, 45.0, unit="deg", minimum=1.0, maximum=180.0,
-                  doc="heading error above which the robot turns on the spot"),
-        InputPort("k", int, 5, minimum=1, maximum=100, doc="headings in the circular median (eqs. 7-8)"),
-        InputPort("min_confidence", float, 0.0, minimum=0.0, maximum=0.99,
-                  doc="confidence mapped to zero speed (eq. 9)"),
-        MIN_MATCHES,
-        InputPort("lost_time", float, 1.0, unit="s", minimum=0.0, doc="how long lost before FAILURE"),
-        InputPort("rotation", str, "zinf", choices=("zinf", "compass"),
-                  doc="zinf: rotation from far landmarks (the paper); compass: from all (for comparison)"),
-        LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, STALLED, COMMAND,
-        OutputPort("estimate", RouteEstimate, ESTIMATE_KEY, doc="the latest estimate against the target"),
-    )  # fmt: skip
+    MIN_SPEED = InputPort("min_speed", float, 0.05, unit="m/s", minimum=0.0, maximum=1.2,
+                          doc="speed floor while the estimate is usable, so a viewframe is always reached")
+    HEADING_GAIN = InputPort("heading_gain", float, 1.5, unit="1/s", minimum=0.01,
+                             doc="turn rate per rad of heading error")
+    TURN_IN_PLACE = InputPort("turn_in_place", float, 45.0, unit="deg", minimum=1.0, maximum=180.0,
+                              doc="heading error above which the robot turns on the spot")
+    K = InputPort("k", int, 5, minimum=1, maximum=100, doc="headings in the circular median (eqs. 7-8)")
+    MIN_CONFIDENCE = InputPort("min_confidence", float, 0.0, minimum=0.0, maximum=0.99,
+                               doc="confidence mapped to zero speed (eq. 9)")
+    LOST_TIME = InputPort("lost_time", float, 1.0, unit="s", minimum=0.0, doc="how long lost before FAILURE")
+    ROTATION = InputPort("rotation", str, "zinf", choices=("zinf", "compass"),
+                         doc="zinf: rotation from far landmarks (the paper); compass: from all (for comparison)")
+    ESTIMATE = OutputPort("estimate", RouteEstimate, ESTIMATE_KEY, doc="the latest estimate against the target")
+    PORTS = (FOLLOW_SPEED, MIN_SPEED, TURN_RATE, HEADING_GAIN, TURN_IN_PLACE, K, MIN_CONFIDENCE, MIN_MATCHES,
+             LOST_TIME, ROTATION, LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, STALLED, COMMAND, ESTIMATE)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -260,7 +210,7 @@ class FollowRoute(BearingsBehaviour):
         self._reset()
 
     def _reset(self) -> None:
-        self._filter = HeadingFilter(int(self.get_input("k")))
+        self._filter = HeadingFilter(self.get_input(self.K))
         self._target: int | None = None
         self._stamp: float | None = None
         self._lost_since: float | None = None
@@ -270,10 +220,10 @@ class FollowRoute(BearingsBehaviour):
         self._reset()
 
     def update(self) -> Status:
-        tree: LandmarkTree | None = self.get_input("ltmap", None)
-        progress: RouteProgress | None = self.get_input("progress", None)
-        observation: Observation | None = self.get_input("observation", None)
-        if self.get_input("stalled", False):
+        tree = self.get_input(LTMAP_IN, None)
+        progress = self.get_input(PROGRESS_IN, None)
+        observation = self.get_input(OBSERVATION_IN, None)
+        if self.get_input(STALLED, False):
             self.feedback_message = "stalled"
             return self._stop(Status.FAILURE)
         if tree is None or progress is None or observation is None:
@@ -287,7 +237,7 @@ class FollowRoute(BearingsBehaviour):
         if observation.stamp != self._stamp:  # a new observation: a new estimate and command
             self._stamp = observation.stamp
             self.estimate = self._estimate(tree, progress.target, observation)
-            self.set_output("estimate", self.estimate)
+            self.set_output(self.ESTIMATE, self.estimate)
             self._command = self._steer(self.estimate)
         return self._lost_or_follow()
 
@@ -296,7 +246,7 @@ class FollowRoute(BearingsBehaviour):
         if estimate is not None and estimate.usable:
             self._lost_since = None
             self._coast = self._command
-            self.set_output("command", self._command)
+            self.set_output(COMMAND, self._command)
             self.feedback_message = (f"viewframe {estimate.viewframe}: {estimate.matched} matched, "
                                      f"error {math.degrees(estimate.error):+.0f} deg")
             return Status.RUNNING
@@ -305,22 +255,22 @@ class FollowRoute(BearingsBehaviour):
         matched = estimate.matched if estimate is not None else 0
         self.feedback_message = f"lost: {matched} landmarks match viewframe {self._target}" + (
             f" ({estimate.status})" if estimate is not None else "")
-        if now - self._lost_since >= float(self.get_input("lost_time")):
+        if now - self._lost_since >= self.get_input(self.LOST_TIME):
             return self._stop(Status.FAILURE)
-        self.set_output("command", self._coast)  # a short gap: keep on as before (STOP before any estimate)
+        self.set_output(COMMAND, self._coast)  # a short gap: keep on as before (STOP before any estimate)
         return Status.RUNNING
 
     def _stop(self, status: Status) -> Status:
-        self.set_output("command", STOP)
+        self.set_output(COMMAND, STOP)
         return status
 
     def _estimate(self, tree: LandmarkTree, target: int, observation: Observation) -> RouteEstimate:
         matches = self.matches = tree.match(target, observation)
-        needed = lost_threshold(len(tree.viewframe(target)), int(self.get_input("min_matches")))
+        needed = lost_threshold(len(tree.viewframe(target)), self.get_input(MIN_MATCHES))
         nan = float("nan")
         if len(matches) < needed:
             return RouteEstimate(target, observation.stamp, len(matches), "lost", math.inf, nan, nan, 0.0)
-        if self.get_input("rotation") == "compass":
+        if self.get_input(self.ROTATION) == "compass":
             motion, fallback = compass_motion(matches.ref, matches.cur, self._rng), False
         else:
             motion, fallback = zinf_motion(matches.ref, matches.cur, self._rng)  # eqs. 2-6
@@ -342,32 +292,33 @@ class FollowRoute(BearingsBehaviour):
     def _steer(self, estimate: RouteEstimate) -> VelocityCommand:
         if not estimate.usable:
             return STOP
-        error, turn = estimate.error, math.radians(float(self.get_input("turn_rate")))
-        w = float(np.clip(float(self.get_input("heading_gain")) * error, -turn, turn))
-        if abs(error) > math.radians(float(self.get_input("turn_in_place"))):
+        error, turn = estimate.error, math.radians(self.get_input(TURN_RATE))
+        w = float(np.clip(self.get_input(self.HEADING_GAIN) * error, -turn, turn))
+        if abs(error) > math.radians(self.get_input(self.TURN_IN_PLACE)):
             return VelocityCommand(0.0, w)
-        speed = scaled_velocity(estimate.confidence, float(self.get_input("speed")),
-                                min_confidence=float(self.get_input("min_confidence")))  # eq. 9
-        v = max(float(self.get_input("min_speed")), speed) * math.cos(error)
+        speed = scaled_velocity(estimate.confidence, self.get_input(FOLLOW_SPEED),
+                                min_confidence=self.get_input(self.MIN_CONFIDENCE))  # eq. 9
+        v = max(self.get_input(self.MIN_SPEED), speed) * math.cos(error)
         return VelocityCommand(v, w)
 
-    def log_rerun(self, rec: Any) -> None:
-        """The estimated direction and the matched landmarks' bearings, in the robot's frame."""
+    def drawings(self) -> Iterator[Drawing]:
+        """While following: the target, matches, ``delta_t`` (capped at 1) and confidence as plots,
+        the estimated direction and the matched landmarks' bearings in the robot's frame."""
         estimate = self.estimate
         if estimate is None or self.status != Status.RUNNING:
             return
-        rec.log("route/target_viewframe", rec.Scalars([float(estimate.viewframe)]))
-        rec.log("route/matched", rec.Scalars([float(estimate.matched)]))
-        rec.log("route/delta_t", rec.Scalars([min(float(estimate.delta_t), 1.0)]))
-        rec.log("route/confidence", rec.Scalars([float(estimate.confidence)]))
+        yield Plot("route/target_viewframe", float(estimate.viewframe))
+        yield Plot("route/matched", float(estimate.matched))
+        yield Plot("route/delta_t", min(float(estimate.delta_t), 1.0))
+        yield Plot("route/confidence", float(estimate.confidence))
         if estimate.usable:
-            rec.log("route/robot_frame/direction", rec.Arrows2D(
-                vectors=[[math.cos(estimate.error), math.sin(estimate.error)]], colors=[[255, 80, 0]]))
+            direction = np.array([[math.cos(estimate.error), math.sin(estimate.error)]])
+            yield Arrows("route/robot_frame/direction", direction, colours=(255, 80, 0))
         if self.matches is not None and len(self.matches):
             cur = np.asarray(self.matches.cur)
             azimuth = np.arctan2(cur[:, 1], cur[:, 0])
-            rec.log("route/robot_frame/matched_landmarks", rec.Points2D(
-                np.column_stack((np.cos(azimuth), np.sin(azimuth))), radii=0.02, colors=[[40, 160, 255]]))
+            yield Points("route/robot_frame/matched_landmarks", np.column_stack((np.cos(azimuth), np.sin(azimuth))),
+                         colours=(40, 160, 255), radius=0.02)
 
 
 @register
@@ -380,20 +331,18 @@ class ViewframeSwitch(BearingsBehaviour):
     Reports every switch (viewframe, time, rule) in the ``ltmap`` section.
     """
 
-    PORTS = (
-        InputPort("threshold", float, 0.0, unit="rad^2", minimum=0.0,
-                  doc="eq. 1 switch threshold; 0: the one the map was taught with"),
-        InputPort("goal_fraction", float, 0.25, minimum=0.01, maximum=1.0,
-                  doc="the route's last viewframe is reached under this fraction of the threshold"),
-        InputPort("flip_angle", float, 90.0, unit="deg", minimum=1.0, maximum=180.0,
-                  doc="a change of the direction to the target larger than this: it was passed"),
-        InputPort("flip_near", float, 4.0, minimum=1.0,
-                  doc="a flip counts only while delta_t is under this many thresholds (near the viewframe)"),
-        TURN_RATE,
-        LTMAP_IN, PROGRESS_IN, ODOMETRY,
-        InputPort("estimate", RouteEstimate, Ref(ESTIMATE_KEY), doc="the latest estimate (FollowRoute)"),
-        OutputPort("advanced", RouteProgress, PROGRESS_KEY, doc="the progress after a switch"),
-    )  # fmt: skip
+    THRESHOLD = InputPort("threshold", float, 0.0, unit="rad^2", minimum=0.0,
+                          doc="eq. 1 switch threshold; 0: the one the map was taught with")
+    GOAL_FRACTION = InputPort("goal_fraction", float, 0.25, minimum=0.01, maximum=1.0,
+                              doc="the route's last viewframe is reached under this fraction of the threshold")
+    FLIP_ANGLE = InputPort("flip_angle", float, 90.0, unit="deg", minimum=1.0, maximum=180.0,
+                           doc="a change of the direction to the target larger than this: it was passed")
+    FLIP_NEAR = InputPort("flip_near", float, 4.0, minimum=1.0,
+                          doc="a flip counts only while delta_t is under this many thresholds (near the viewframe)")
+    ESTIMATE = InputPort("estimate", RouteEstimate, Ref(ESTIMATE_KEY), doc="the latest estimate (FollowRoute)")
+    ADVANCED = OutputPort("advanced", RouteProgress, PROGRESS_KEY, doc="the progress after a switch")
+    PORTS = (THRESHOLD, GOAL_FRACTION, FLIP_ANGLE, FLIP_NEAR, TURN_RATE, LTMAP_IN, PROGRESS_IN, ODOMETRY, ESTIMATE,
+             ADVANCED)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -406,12 +355,12 @@ class ViewframeSwitch(BearingsBehaviour):
     @property
     def block_time(self) -> float:
         """Seconds the flip rule waits after a switch: a 180 degree turn at ``turn_rate``."""
-        return 180.0 / float(self.get_input("turn_rate"))
+        return 180.0 / self.get_input(TURN_RATE)
 
     def update(self) -> Status:
-        progress: RouteProgress | None = self.get_input("progress", None)
-        estimate: RouteEstimate | None = self.get_input("estimate", None)
-        tree: LandmarkTree | None = self.get_input("ltmap", None)
+        progress = self.get_input(PROGRESS_IN, None)
+        estimate = self.get_input(self.ESTIMATE, None)
+        tree = self.get_input(LTMAP_IN, None)
         if progress is None or tree is None:
             self.feedback_message = "waiting for the route progress and the map"
             return Status.RUNNING
@@ -422,7 +371,7 @@ class ViewframeSwitch(BearingsBehaviour):
         if self._last is None or self._last[0] != progress.target:
             self._heading = None
         self._last = (estimate.viewframe, estimate.stamp)
-        rule = self._rule(estimate, progress, float(self.get_input("threshold")) or tree.threshold)
+        rule = self._rule(estimate, progress, self.get_input(self.THRESHOLD) or tree.threshold)
         if math.isfinite(estimate.heading):
             self._heading = estimate.heading
         self.feedback_message = f"target {progress.target}, delta_t {estimate.delta_t:.2g}"
@@ -430,36 +379,38 @@ class ViewframeSwitch(BearingsBehaviour):
             return Status.RUNNING
         now = self.now()
         self.reached.append({"viewframe": progress.target, "time_s": round(now, 3), "rule": rule})
-        pose = self.get_input("odometry", None)
+        pose = self.get_input(ODOMETRY, None)
         if pose is not None:
             self._reached_at.append([pose.x, pose.y])
         advanced = progress.advanced(now)
-        self.set_output("advanced", advanced)
+        self.set_output(self.ADVANCED, advanced)
         self._heading = None
         return Status.SUCCESS if advanced.finished else Status.RUNNING
 
     def _rule(self, estimate: RouteEstimate, progress: RouteProgress, threshold: float) -> str | None:
         if progress.remaining == 1:  # the goal: home closer than the switching radius of the others
-            threshold *= float(self.get_input("goal_fraction"))
+            threshold *= self.get_input(self.GOAL_FRACTION)
         if estimate.delta_t < threshold:  # eq. 1 under the threshold: at the viewframe
             return "delta_t"
         blocked = self.now() - progress.switched_at < self.block_time
-        far = estimate.delta_t >= float(self.get_input("flip_near")) * threshold
+        far = estimate.delta_t >= self.get_input(self.FLIP_NEAR) * threshold
         if blocked or far or self._heading is None or not math.isfinite(estimate.heading):
             return None
-        limit = math.radians(float(self.get_input("flip_angle")))
+        limit = math.radians(self.get_input(self.FLIP_ANGLE))
         return "flip" if heading_flipped(self._heading, estimate.heading, limit=limit) else None
 
-    def report_sections(self) -> dict[str, dict[str, Any]]:
+    def figures(self) -> Iterator[Figure]:
         rules = [r["rule"] for r in self.reached]
-        return {"ltmap": {"switches": len(self.reached), "switches_by_flip": rules.count("flip"),
-                          "reached": list(self.reached)}}
+        yield Figure("ltmap", "switches", len(self.reached))
+        yield Figure("ltmap", "switches_by_flip", rules.count("flip"))
+        yield Figure("ltmap", "reached", list(self.reached))
 
-    def log_rerun(self, rec: Any) -> None:
-        """Where the viewframes were reached (odometry frame) and a line per switch."""
-        for entry in self.reached[self._logged:]:
-            rec.log("route/events", rec.TextLog(f"viewframe {entry['viewframe']} reached ({entry['rule']})"))
-        if len(self.reached) > self._logged and self._reached_at:
-            rec.log("odometry_frame/route/reached_viewframes", rec.Points2D(self._reached_at, radii=0.05,
-                                                                           colors=[[0, 200, 120]]))
+    def drawings(self) -> Iterator[Drawing]:
+        """Each new switch as an event, and where the viewframes were reached (odometry frame)."""
+        new = self.reached[self._logged:]
         self._logged = len(self.reached)
+        for entry in new:
+            yield Event("route/events", f"viewframe {entry['viewframe']} reached ({entry['rule']})")
+        if new and self._reached_at:
+            yield Points("odometry_frame/route/reached_viewframes", np.array(self._reached_at), colours=(0, 200, 120),
+                         radius=0.05)

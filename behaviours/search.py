@@ -24,18 +24,11 @@ from behaviours.landmark_tree import LTMAP_IN
 from behaviours.motion import COMMAND, ODOMETRY, STALLED
 from behaviours.ports import InputPort, OutputPort
 from behaviours.registry import register
-from behaviours.route import (
-    MIN_MATCHES,
-    OBSERVATION_IN,
-    PROGRESS_IN,
-    PROGRESS_KEY,
-    RouteProgress,
-    lost_threshold,
-    zinf_motion,
-)
+from behaviours.route import MIN_MATCHES, OBSERVATION_IN, PROGRESS_IN, PROGRESS_KEY, RouteProgress
 from behaviours.telemetry import Drawing, Figure, Lines
 from drivers.interfaces import STOP, VelocityCommand
 from perception.geometry import Pose2D, wrap_angle
+from perception.viewframe_motion import lost_threshold, zinf_motion
 
 
 def lying_eight(width: float, points: int = 64) -> np.ndarray:
@@ -52,8 +45,9 @@ class SearchPattern(BearingsBehaviour):
     """Drive a lying eight ``width`` across until the trail is found; then SUCCESS.
 
     Found: a viewframe among the target and the next ``window`` along the route matches at least
-    as many landmarks as following needs (``min_matches``, see ``route.lost_threshold``) with a
-    valid Z-infinity rotation; it becomes the target (``found`` output).
+    as many landmarks as following needs (``min_matches``, see
+    :func:`perception.viewframe_motion.lost_threshold`) with a valid Z-infinity rotation; it
+    becomes the target (``found`` output).
     """
 
     WIDTH = InputPort("width", float, 1.2, unit="m", minimum=0.1, maximum=10.0, doc="the eight from end to end")

@@ -3,7 +3,7 @@
 ``LearnRoute`` is a decorator: its child is whatever drives the route (``DriveWaypoints`` on
 odometry in the simulator, ``KeyboardTeleop`` with an operator on a robot). Every tick it feeds
 each new observation, with the camera's heading from odometry, to a
-:class:`maps.ltmap.RouteLearner` (algorithm 1: a viewframe whenever ``delta_t`` passes the
+:class:`maps.ltmap.learner.RouteLearner` (algorithm 1: a viewframe whenever ``delta_t`` passes the
 threshold; with a budget, pruned online so the route's length need not be known). When the
 child succeeds, the route is finished (the goal becomes the last viewframe), saved atomically
 to ``path`` and the decorator succeeds. When the child fails, or the run is stopped, nothing is
@@ -16,17 +16,22 @@ turns those times into places with the simulator's ground-truth trajectory.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from collections.abc import Iterator
+from typing import Any
 
+import numpy as np
 import py_trees
 from py_trees.common import Status
 
 from behaviours.base import BearingsDecorator
 from behaviours.landmark_tree import LTMAP_OUT, save_map, summary_section
 from behaviours.motion import ODOMETRY
-from behaviours.ports import InputPort, Port, Ref
+from behaviours.ports import InputPort, Ref
 from behaviours.registry import register
-from maps.ltmap import DEFAULT_MIN_LANDMARKS, DEFAULT_THRESHOLD, LearnConfig, LearnStep, RouteLearner
+from behaviours.telemetry import Drawing, Figure, Points, section
+from maps.ltmap.learner import LearnConfig, LearnStep, RouteLearner
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
+from maps.ltmap.tree import DEFAULT_THRESHOLD
 from maps.store import InputError
 from perception.geometry import Pose2D
 from perception.observation import Observation
@@ -40,24 +45,21 @@ class LearnRoute(BearingsDecorator):
     child fails (nothing saved), when nothing was observed, or when the file cannot be written.
     """
 
-    PORTS: ClassVar[tuple[Port, ...]] = (
-        InputPort("path", str, "", literal_only=True, doc="the LT-map file written at the end; empty: not saved"),
-        InputPort("threshold", float, DEFAULT_THRESHOLD, unit="rad^2", minimum=1e-9, literal_only=True,
-                  doc="eq. 1: a new viewframe when delta_t passes it"),
-        InputPort("budget", int, 0, unit="B", minimum=0, literal_only=True,
-                  doc="memory budget, pruned online while teaching; 0: none"),
-        InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0, literal_only=True,
-                  doc="pruning deletes viewframes left with fewer landmarks (the paper: 50)"),
-        InputPort("observation", Observation, Ref("/perception/observation"), doc="the landmarks seen now"),
-        ODOMETRY,
-        LTMAP_OUT,
-    )
+    PATH = InputPort("path", str, "", literal_only=True, doc="the LT-map file written at the end; empty: not saved")
+    THRESHOLD = InputPort("threshold", float, DEFAULT_THRESHOLD, unit="rad^2", minimum=1e-9, literal_only=True,
+                          doc="eq. 1: a new viewframe when delta_t passes it")
+    BUDGET = InputPort("budget", int, 0, unit="B", minimum=0, literal_only=True,
+                       doc="memory budget, pruned online while teaching; 0: none")
+    MIN_LANDMARKS = InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0, literal_only=True,
+                              doc="pruning deletes viewframes left with fewer landmarks (the paper: 50)")
+    OBSERVATION = InputPort("observation", Observation, Ref("/perception/observation"), doc="the landmarks seen now")
+    PORTS = (PATH, THRESHOLD, BUDGET, MIN_LANDMARKS, OBSERVATION, ODOMETRY, LTMAP_OUT)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
-        budget = int(self.get_input("budget"))
-        self.config = LearnConfig(threshold=float(self.get_input("threshold")), budget_bytes=budget or None,
-                                  min_landmarks=int(self.get_input("min_landmarks")))
+        self.config = LearnConfig(threshold=self.get_input(self.THRESHOLD),
+                                  budget_bytes=self.get_input(self.BUDGET) or None,
+                                  min_landmarks=self.get_input(self.MIN_LANDMARKS))
         self.learner = RouteLearner(self.config)
         self.taught: list[float] = []  # per viewframe, the tree time it was made
         self.places: list[list[float]] = []  # per viewframe, the odometry (x, y) it was made at (recording)
@@ -83,8 +85,8 @@ class LearnRoute(BearingsDecorator):
         return self._finish()
 
     def _learn(self) -> None:
-        observation: Observation | None = self.get_input("observation", None)
-        pose: Pose2D | None = self.get_input("odometry", None)
+        observation = self.get_input(self.OBSERVATION, None)
+        pose = self.get_input(ODOMETRY, None)
         if observation is None or pose is None or observation.stamp == self._stamp:
             return
         self._stamp = observation.stamp
@@ -104,17 +106,17 @@ class LearnRoute(BearingsDecorator):
             self.places.append([pose.x, pose.y])
         tree = self.learner.tree
         if tree is not None and (step.created or step.pruned is not None):
-            self.set_output("ltmap", tree)
+            self.set_output(LTMAP_OUT, tree)
             self.taught, self.places = self.taught[:tree.viewframe_count], self.places[:tree.viewframe_count]
 
     def _finish(self) -> Status:
         if self.learner.tree is None:
             self.feedback_message = "nothing was observed: there is no route to save"
             return Status.FAILURE
-        pose: Pose2D = self.get_input("odometry", Pose2D())
+        pose = self.get_input(ODOMETRY, Pose2D())
         self._record(self.learner.finish(), pose)
         tree = self.learner.tree
-        path = str(self.get_input("path"))
+        path = self.get_input(self.PATH)
         if path:
             try:
                 save_map(path, tree)
@@ -122,22 +124,21 @@ class LearnRoute(BearingsDecorator):
                 self.feedback_message = f"cannot save the map: {str(exc).splitlines()[0]}"
                 return Status.FAILURE
             self.saved = True
-        self.set_output("ltmap", tree)
+        self.set_output(LTMAP_OUT, tree)
         self.feedback_message = f"{tree.viewframe_count} viewframes, {tree.memory_bytes()} bytes" + (
             f", saved to {path}" if path else "")
         return Status.SUCCESS
 
-    def report_sections(self) -> dict[str, dict[str, Any]]:
+    def figures(self) -> Iterator[Figure]:
         tree = self.learner.tree
         if tree is None:
-            return {}
+            return
         taught = [{"viewframe": i, "time_s": t} for i, t in enumerate(self.taught)]
-        return {"ltmap": {**summary_section(tree.summary()), "map_file": str(self.get_input("path")),
-                          "saved": self.saved, "online_prunes": self.prunes, "taught": taught}}
+        yield from section("ltmap", {**summary_section(tree.summary()), "map_file": self.get_input(self.PATH),
+                                     "saved": self.saved, "online_prunes": self.prunes, "taught": taught})
 
-    def log_rerun(self, rec: Any) -> None:
-        """The viewframes made so far, where odometry put them."""
+    def drawings(self) -> Iterator[Drawing]:
+        """The viewframes made so far, where odometry put them (when there are new ones)."""
         if len(self.places) != self._logged and self.places:
             self._logged = len(self.places)
-            rec.log("odometry_frame/route/viewframes", rec.Points2D(self.places, radii=0.05,
-                                                                    colors=[[255, 200, 0]]))
+            yield Points("odometry_frame/route/viewframes", np.array(self.places), colours=(255, 200, 0), radius=0.05)

@@ -24,7 +24,9 @@ from typing import Any
 
 import numpy as np
 
-from maps.ltmap import IDS, LandmarkTree, RouteLearner
+from maps.ltmap.arrays import IDS
+from maps.ltmap.learner import RouteLearner
+from maps.ltmap.tree import LandmarkTree
 from perception.observation import Observation
 from perception.synthetic_route import make_route_world, observe_route, straight_route
 

@@ -13,8 +13,8 @@ import json
 import math
 import re
 
-from maps.ltmap import DEFAULT_MIN_LANDMARKS
-from maps.ltmap_file import load_ltmap, save_ltmap
+from maps.ltmap.file import load_ltmap, save_ltmap
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
 from maps.store import InputError
 from missions.commands.common import EXIT_INVALID, EXIT_OK, fail
 

@@ -55,8 +55,9 @@ import numpy as np
 
 from drivers.sim.simulation import path_distances
 from drivers.sim.world import World, load_world
-from maps.ltmap import DEFAULT_MIN_LANDMARKS, LandmarkTree
-from maps.ltmap_file import load_ltmap
+from maps.ltmap.file import load_ltmap
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
+from maps.ltmap.tree import LandmarkTree
 from missions.eval import EvalOptions
 from missions.eval.figures import cell, mean_present
 from missions.eval.ltmap_route import Route, default_route, given_route, parse_route

@@ -8,7 +8,7 @@ import numpy as np
 
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP
-from maps.ltmap import LearnConfig, RouteLearner
+from maps.ltmap.learner import LearnConfig, RouteLearner
 from perception.geometry import Pose2D
 from perception.synthetic_route import make_route_world, observe_route, straight_route
 

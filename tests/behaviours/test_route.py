@@ -9,22 +9,13 @@ import pytest
 from py_trees.common import Status
 
 from behaviours.control import Parallel
-from behaviours.route import (
-    FollowRoute,
-    RouteEstimate,
-    RouteProgress,
-    StartRoute,
-    ViewframeSwitch,
-    compass_motion,
-    lost_threshold,
-    zinf_motion,
-)
+from behaviours.route import FollowRoute, RouteEstimate, RouteProgress, StartRoute, ViewframeSwitch
+from behaviours.telemetry import Arrows, Event, Plot, Points, report_sections
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP
 from perception.geometry import Pose2D
 from perception.observation import Observation
-from perception.synthetic_route import observe_route
-from tests.behaviours.routes import WORLD, IdealBase, taught_map
+from tests.behaviours.routes import IdealBase, taught_map
 
 TREE, PLACES = taught_map()
 
@@ -44,12 +35,6 @@ def test_progress_advances_and_finishes():
     progress = progress.advanced(1.0).advanced(2.0)
     assert (progress.target, progress.switches, progress.switched_at, progress.remaining) == (0, 2, 2.0, 1)
     assert progress.advanced(3.0).finished
-
-
-def test_lost_threshold_is_the_papers_50_unless_the_viewframe_is_small():
-    assert lost_threshold(400, 50) == 50
-    assert lost_threshold(24, 50) == 12  # the ideal sensor in a room: half the viewframe
-    assert lost_threshold(6, 50) == 8  # never under Z-infinity's minimum
 
 
 def follow_harness(pose: Pose2D, target: int, **ports) -> BehaviourHarness:
@@ -132,8 +117,8 @@ def test_switch_moves_on_when_delta_t_falls_under_the_threshold():
     assert harness.tick() == Status.RUNNING
     progress = harness.read("/map/route_progress")
     assert (progress.target, progress.switches, progress.switched_at) == (3, 1, 1.5)
-    reached = harness.behaviour.report_sections()["ltmap"]["reached"]
-    assert reached == [{"viewframe": 2, "time_s": 1.5, "rule": "delta_t"}]
+    assert report_sections(harness.behaviour) == {"ltmap": {
+        "switches": 1, "switches_by_flip": 0, "reached": [{"viewframe": 2, "time_s": 1.5, "rule": "delta_t"}]}}
 
 
 def test_flip_rule_is_blocked_for_a_half_turn_after_a_switch():
@@ -150,7 +135,7 @@ def test_flip_rule_is_blocked_for_a_half_turn_after_a_switch():
         harness.write("/map/route_estimate", estimate(2, t, near, heading))
         harness.tick()
     assert harness.read("/map/route_progress").target == 3
-    assert harness.behaviour.report_sections()["ltmap"]["switches_by_flip"] == 1
+    assert report_sections(harness.behaviour)["ltmap"]["switches_by_flip"] == 1
 
 
 def test_a_flip_far_from_the_viewframe_is_noise():
@@ -191,14 +176,31 @@ def test_following_the_whole_route_reaches_its_end(direction):
     assert harness.read("/map/route_progress").switches == TREE.viewframe_count
 
 
-def test_zinf_keeps_the_rotation_where_a_compass_of_near_landmarks_is_pulled_off():
-    rng = np.random.default_rng(3)
-    place = PLACES[len(PLACES) // 2]
-    ref = observe_route(WORLD, place, rng)
-    cur = observe_route(WORLD, Pose2D(place.x + 0.3, place.y + 0.3, 0.5), rng)
-    _, a, b = np.intersect1d(ref.ids, cur.ids, return_indices=True)
-    zinf, fallback = zinf_motion(ref.bearings[a], cur.bearings[b], rng)
-    assert not fallback
-    compass = compass_motion(ref.bearings[a], cur.bearings[b], rng)
-    assert abs(zinf.yaw + 0.5) < math.radians(0.5)
-    assert abs(compass.yaw + 0.5) > abs(zinf.yaw + 0.5)
+def test_follow_route_draws_its_estimate_while_it_follows():
+    target = len(PLACES) // 2
+    harness = follow_harness(Pose2D(), target, k=1)
+    IdealBase(harness, Pose2D(PLACES[target].x - 0.4, 0.0, 0.0))
+    node = harness.behaviour
+    assert list(node.drawings()) == []  # nothing estimated yet
+    harness.tick()
+    drawn = {d.entity: d for d in node.drawings()}
+    estimate = harness.read("/map/route_estimate")
+    assert drawn["route/target_viewframe"] == Plot("route/target_viewframe", float(target))
+    assert drawn["route/matched"].value == estimate.matched and drawn["route/delta_t"].value <= 1.0
+    arrow = drawn["route/robot_frame/direction"]
+    assert isinstance(arrow, Arrows) and arrow.colours == (255, 80, 0)
+    assert np.allclose(arrow.vectors, [[math.cos(estimate.error), math.sin(estimate.error)]])
+    matched = drawn["route/robot_frame/matched_landmarks"]
+    assert isinstance(matched, Points) and len(matched.positions) == estimate.matched and matched.radius == 0.02
+    assert report_sections(node) == {}  # following adds nothing to the report
+
+
+def test_switch_draws_each_switch_once():
+    harness = switch_harness(RouteProgress(1, 2, 5, 0.0))
+    harness.write("/robot/odometry", Pose2D(1.0, 0.5, 0.0))
+    harness.write("/map/route_estimate", estimate(2, 1.0, TREE.threshold / 2))
+    harness.tick()
+    drawn = list(harness.behaviour.drawings())
+    assert drawn[0] == Event("route/events", "viewframe 2 reached (delta_t)")
+    assert drawn[1].entity == "odometry_frame/route/reached_viewframes" and drawn[1].positions.tolist() == [[1.0, 0.5]]
+    assert list(harness.behaviour.drawings()) == []  # nothing new: nothing drawn

@@ -1,4 +1,4 @@
-"""Teaching and map nodes in isolation: LearnRoute around a scripted drive, LoadMap, PruneMap."""
+"""LearnRoute in isolation: teaching around a scripted drive, saving, online pruning, its report and drawings."""
 
 from __future__ import annotations
 
@@ -7,12 +7,12 @@ import py_trees
 import pytest
 from py_trees.common import Status
 
-from behaviours.landmark_tree import LoadMap, PruneMap
 from behaviours.teach import LearnRoute
+from behaviours.telemetry import Points, report_sections
 from behaviours.testing import BehaviourHarness
-from maps.ltmap_file import load_ltmap, save_ltmap
+from maps.ltmap.file import load_ltmap
 from perception.synthetic_route import observe_route, straight_route
-from tests.behaviours.routes import WORLD, taught_map
+from tests.behaviours.routes import WORLD
 
 
 class Scripted(py_trees.behaviour.Behaviour):
@@ -48,8 +48,11 @@ def test_learn_route_saves_the_map_when_the_drive_succeeds(tmp_path):
     assert teach(harness, poses[-1:]) == Status.SUCCESS
     saved = load_ltmap(path)
     assert saved.viewframe_count == harness.read("/map/ltmap").viewframe_count
-    section = node.report_sections()["ltmap"]
+    section = report_sections(node)["ltmap"]
     assert section["saved"] and section["viewframes"] == saved.viewframe_count
+    assert list(section) == ["landmark_kind", "viewframes", "landmarks", "nodes", "height", "bytes",
+                             "landmarks_per_level", "threshold", "map_file", "saved", "online_prunes", "taught"]
+    assert section["map_file"] == str(path) and section["online_prunes"] == 0
     times = [entry["time_s"] for entry in section["taught"]]
     assert len(times) == saved.viewframe_count and times == sorted(times) and times[-1] == pytest.approx(6.0)
 
@@ -78,42 +81,18 @@ def test_learn_route_prunes_online_to_its_budget_and_keeps_the_taught_times():
     harness = BehaviourHarness(node)
     assert teach(harness, poses) == Status.SUCCESS
     tree = harness.read("/map/ltmap")
-    section = node.report_sections()["ltmap"]
+    section = report_sections(node)["ltmap"]
     assert tree.memory_bytes() <= budget and section["online_prunes"] > 0
     assert len(section["taught"]) == tree.viewframe_count and section["taught"][0]["time_s"] == pytest.approx(0.1)
 
 
-def test_load_map_puts_the_file_on_the_blackboard_and_fails_on_a_bad_file(tmp_path):
-    tree, _ = taught_map()
-    good, bad = tmp_path / "good.ltmap", tmp_path / "bad.ltmap"
-    save_ltmap(good, tree)
-    bad.write_bytes(good.read_bytes()[:-10])
-    harness = BehaviourHarness(LoadMap(path=str(good)))
-    assert harness.tick() == Status.SUCCESS
-    assert harness.read("/map/ltmap").viewframe_count == tree.viewframe_count
-    assert harness.behaviour.report_sections()["ltmap"]["bytes"] == tree.memory_bytes()
-    failing = BehaviourHarness(LoadMap(path=str(bad)))
-    assert failing.tick() == Status.FAILURE and "bad.ltmap" in failing.behaviour.feedback_message
-    assert BehaviourHarness(LoadMap(path=str(tmp_path / "none.ltmap"))).tick() == Status.FAILURE
-
-
-def test_prune_map_to_a_fraction_reports_where_its_viewframes_came_from(tmp_path):
-    tree, _ = taught_map()
-    harness = BehaviourHarness(PruneMap(fraction=0.6, min_landmarks=5, path=str(tmp_path / "pruned.ltmap")),
-                               blackboard={"/map/ltmap": tree})
-    assert harness.tick() == Status.SUCCESS
-    pruned = harness.read("/map/ltmap")
-    section = harness.behaviour.report_sections()["ltmap"]
-    assert pruned.memory_bytes() <= 0.6 * tree.memory_bytes() and section["memory_fraction"] <= 0.6
-    assert len(section["viewframe_source"]) == pruned.viewframe_count
-    assert section["viewframe_source"][0] == 0 and section["viewframe_source"][-1] == tree.viewframe_count - 1
-    assert tree.viewframe_count > pruned.viewframe_count  # the input map was not changed in place
-    assert load_ltmap(tmp_path / "pruned.ltmap").viewframe_count == pruned.viewframe_count
-
-
-def test_prune_map_fails_when_the_budget_cannot_be_met_and_passes_a_map_without_one():
-    tree, _ = taught_map()
-    harness = BehaviourHarness(PruneMap(budget=10), blackboard={"/map/ltmap": tree})
-    assert harness.tick() == Status.FAILURE and "over the 10 byte budget" in harness.behaviour.feedback_message
-    whole = BehaviourHarness(PruneMap(), blackboard={"/map/ltmap": tree})
-    assert whole.tick() == Status.SUCCESS and whole.read("/map/ltmap").memory_bytes() == tree.memory_bytes()
+def test_learn_route_reports_nothing_before_its_first_observation_and_draws_new_viewframes_once():
+    poses = straight_route(1.0, 0.05)
+    node = LearnRoute(name="learn", child=Scripted(len(poses)))
+    harness = BehaviourHarness(node)
+    assert report_sections(node) == {} and list(node.drawings()) == []
+    teach(harness, poses[:6])
+    (drawn,) = node.drawings()
+    assert isinstance(drawn, Points) and drawn.entity == "odometry_frame/route/viewframes"
+    assert drawn.positions.tolist() == node.places and drawn.colours == (255, 200, 0) and drawn.radius == 0.05
+    assert list(node.drawings()) == []  # no new viewframe: nothing drawn

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from maps.ltmap import RouteLearner
-from maps.ltmap_file import KIND, decode_ltmap, encode_ltmap, load_ltmap, save_ltmap
+from maps.ltmap.file import KIND, decode_ltmap, encode_ltmap, load_ltmap, save_ltmap
+from maps.ltmap.learner import RouteLearner
 from maps.mapfile import encode_map
 from maps.store import InputError
 from perception.synthetic_route import make_route_world, observe_route, straight_route

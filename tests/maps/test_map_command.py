@@ -7,8 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from maps.ltmap import RouteLearner
-from maps.ltmap_file import load_ltmap, save_ltmap
+from maps.ltmap.file import load_ltmap, save_ltmap
+from maps.ltmap.learner import RouteLearner
 from missions.cli import main
 from missions.commands.map import parse_byte_size
 from perception.synthetic_route import make_route_world, observe_route, straight_route

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from maps.ltmap_file import load_ltmap
+from maps.ltmap.file import load_ltmap
 from missions.cli import main
 from missions.loader import load_mission
 

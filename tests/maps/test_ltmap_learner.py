@@ -1,11 +1,12 @@
-"""Teaching an LT-map on synthetic routes whose truth is known (perception.synthetic_route)."""
+"""maps.ltmap.learner: teaching an LT-map on synthetic routes whose truth is known (perception.synthetic_route)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from maps.ltmap import IDS, LearnConfig, RouteLearner, threshold_angle
+from maps.ltmap.arrays import IDS
+from maps.ltmap.learner import LearnConfig, RouteLearner, compensate, threshold_angle
 from perception.geometry import Pose2D
 from perception.observation import Observation
 from perception.similarity import DEFAULT_SCALE, bearing_angles, delta_t
@@ -200,3 +201,8 @@ def test_a_blind_spell_makes_no_empty_viewframes():
     steps = [learner.observe(blind, 0.0) for _ in range(10)]
     assert learner.tree.viewframe_count == count and not any(s.created for s in steps)
     assert all(s.delta_t == np.inf and s.tracked == 0 for s in steps)
+
+
+def test_compensation_turns_body_bearings_into_the_route_frame():
+    ahead = np.array([[1.0, 0.0, 0.0]])
+    assert np.allclose(compensate(ahead, np.pi / 2), [[0.0, 1.0, 0.0]])  # facing +y, "ahead" is +y

@@ -1,4 +1,4 @@
-"""LT-map files: a :class:`~maps.ltmap.LandmarkTree` saved as map kind ``ltmap``, format version 1.
+"""LT-map files: a :class:`~maps.ltmap.tree.LandmarkTree` saved as map kind ``ltmap``, format version 1.
 
 The container (magic line, JSON header with length and SHA-256, ``.npz`` payload, atomic write)
 is :mod:`maps.mapfile`'s; the payload holds exactly :meth:`LandmarkTree.to_arrays`, so a map's
@@ -15,7 +15,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from maps.ltmap import LandmarkTree
+from maps.ltmap.tree import LandmarkTree
 from maps.mapfile import MapFile, decode_map, encode_map, read_map_file, write_map_file
 from maps.store import Diagnostic, InputError
 

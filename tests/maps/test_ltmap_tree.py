@@ -1,4 +1,4 @@
-"""LT-map tree: its invariants across random learn/prune sequences (hypothesis), and its rules.
+"""maps.ltmap.tree: the tree's invariants across random learn/prune sequences (hypothesis), and its rules.
 
 The random trees are built with :meth:`LandmarkTree.add_viewframe` directly (ids kind), every row
 with an id of its own, so ids name rows across pruning and viewframe sets compare as id sets.
@@ -10,64 +10,17 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
 
-from maps.ltmap import IDS, LandmarkSet, LandmarkTree, attach_level, compensate
-from maps.ltmap_file import decode_ltmap, encode_ltmap
-from perception.observation import Observation
+from maps.ltmap.arrays import IDS
+from maps.ltmap.file import decode_ltmap, encode_ltmap
+from maps.ltmap.tree import LandmarkTree, attach_level
 from perception.similarity import bearing_angles
 from perception.synthetic import unit
+from tests.maps.ltmap_trees import Rows, all_sets, check_invariants, id_set, same_arrays
 
 SHARE = 0.05  # rad: the gate of the random sequences
 SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-
-
-class Rows:
-    """Fresh ids and random unit bearings for new rows."""
-
-    def __init__(self, rng: np.random.Generator) -> None:
-        self.rng, self.next_id = rng, 0
-
-    def make(self, bearings: np.ndarray) -> LandmarkSet:
-        ids = np.arange(self.next_id, self.next_id + len(bearings), dtype=np.int64)
-        self.next_id += len(bearings)
-        return LandmarkSet(np.asarray(bearings, dtype=np.float64).reshape(-1, 3), ids=ids)
-
-    def random(self, count: int) -> LandmarkSet:
-        return self.make(unit(self.rng.normal(size=(count, 3))))
-
-
-def id_set(tree: LandmarkTree, index: int) -> frozenset[int]:
-    return frozenset(tree.ids[tree.viewframe(index).landmarks].tolist())
-
-
-def all_sets(tree: LandmarkTree) -> list[frozenset[int]]:
-    return [id_set(tree, i) for i in range(tree.viewframe_count)]
-
-
-def same_arrays(a: dict, b: dict) -> bool:
-    return a.keys() == b.keys() and all(np.array_equal(a[k], b[k]) and a[k].dtype == b[k].dtype for k in a)
-
-
-def check_invariants(tree: LandmarkTree) -> None:
-    nodes, views = tree.node_count, tree.viewframe_count
-    stored = np.concatenate([tree.node_landmarks(n) for n in range(nodes)] or [np.zeros(0, int)])
-    assert np.array_equal(np.sort(stored), np.arange(tree.landmark_count)), "each landmark in exactly one node"
-    assert len(np.unique(tree.ids)) == tree.landmark_count  # no row was duplicated
-    branches = [tree.branch_nodes(i) for i in range(views)]
-    assert set().union(*branches) == set(range(nodes)), "every node lies on some viewframe's branch"
-    parents = set(tree.node_parents) - {-1}
-    assert set(tree.viewframe_leaves) == set(range(nodes)) - parents and len(set(tree.viewframe_leaves)) == views
-    assert {int(tree.depths()[leaf]) for leaf in tree.viewframe_leaves} <= {tree.height}
-    for i, branch in enumerate(branches):
-        union = np.concatenate([tree.node_landmarks(n) for n in branch])
-        assert id_set(tree, i) == frozenset(tree.ids[union].tolist()), "viewframe = union along its branch"
-        fresh = tree.viewframe(i, cached=False)  # the cache holds what a rebuild gives
-        assert np.array_equal(tree.viewframe(i).landmarks, fresh.landmarks)
-        assert np.array_equal(tree.viewframe(i).bearings, fresh.bearings)
-    arrays = tree.to_arrays()
-    assert tree.memory_bytes() == sum(a.nbytes for a in arrays.values())
-    twin = LandmarkTree.from_arrays(arrays, kind=IDS, threshold=tree.threshold)
-    assert same_arrays(twin.to_arrays(), arrays) and all_sets(twin) == all_sets(tree)
 
 
 def add_step(tree: LandmarkTree, rows: Rows, data: st.DataObject) -> None:
@@ -153,22 +106,6 @@ def test_invariants_hold_across_random_learn_and_prune_sequences(data, seed):
     assert same_arrays(decoded.to_arrays(), tree.to_arrays()) and decoded.threshold == tree.threshold
 
 
-@SETTINGS
-@given(st.integers(0, 2**32 - 1), st.integers(1, 12))
-def test_memory_never_grows_under_pruning_and_reaches_height_zero(seed, views):
-    rng = np.random.default_rng(seed)
-    tree, rows = LandmarkTree(IDS), Rows(rng)
-    for _ in range(views):
-        last = tree.viewframe(-1).landmarks if tree.viewframe_count else np.zeros(0, dtype=np.int64)
-        tracked = last[rng.random(len(last)) < 0.6]
-        tree.add_viewframe(tracked, rows.make(tree.bearings[tracked]), rows.random(int(rng.integers(0, 40))))
-    sizes = [tree.memory_bytes()]
-    while tree.prune_level(int(rng.integers(0, 40))) is not None:
-        sizes.append(tree.memory_bytes())
-    assert all(a > b for a, b in zip(sizes, sizes[1:], strict=False))
-    assert tree.height == 0 and len(sizes) - 1 <= views
-
-
 def test_the_branch_leaves_where_the_fewest_landmarks_go_wrong():
     # nothing lost above the leaf: the new viewframe is the last one's sibling (tracked move one level up)
     assert attach_level(lost=[0, 0, 5], tracked=[9, 4, 7], leaves=[6, 1, 1]) == 2
@@ -186,35 +123,12 @@ def test_only_bearings_within_the_share_angle_are_shared():
     rows = Rows(np.random.default_rng(3))
     tree = LandmarkTree(IDS)
     tree.add_viewframe([], rows.make(np.empty((0, 3))), rows.random(10))
-    turned = compensate(tree.bearings[[0]], 0.3)  # one landmark now seen 0.3 rad away from its stored bearing
+    turned = Rotation.from_euler("z", 0.3).apply(tree.bearings[[0]])  # one landmark now seen 0.3 rad away
     sightings = rows.make(np.vstack((turned, tree.bearings[[1]])))
     tree.add_viewframe([0, 1], sightings, rows.make(np.empty((0, 3))), share_angle=0.1)
     shared, stored = id_set(tree, 1), tree.ids[tree.node_landmarks(tree.viewframe_leaves[1])]
     assert 1 in shared and 0 not in shared and list(stored) == [int(sightings.ids[0])]
     assert bearing_angles(tree.bearings[[-1]], turned)[0] < 1e-6  # stored with its bearing now
-
-
-def test_matching_uses_the_cached_stack_until_the_map_changes():
-    rows = Rows(np.random.default_rng(5))
-    tree = LandmarkTree(IDS)
-    first = rows.random(60)
-    tree.add_viewframe([], rows.make(np.empty((0, 3))), first)
-    observation = Observation(first.bearings[::2][:, [1, 0, 2]], 0.0, "bearings", ids=first.ids[::2])
-    matched = tree.match(0, observation)
-    assert np.array_equal(tree.viewframe(0).ids[matched.landmark], first.ids[::2])
-    assert np.allclose(matched.ref, first.bearings[::2], atol=1e-6)
-    assert np.array_equal(matched.cur, observation.bearings)
-    assert tree.viewframe(0) is tree.viewframe(0)  # built once
-    stack = tree.viewframe(0)
-    tree.add_viewframe(tree.viewframe(0).landmarks[:10], rows.make(tree.bearings[:10]), rows.random(5))
-    assert tree.viewframe(0) is not stack  # a change invalidates
-    with pytest.raises(ValueError, match="ids"):
-        tree.match(0, Observation(first.bearings, 0.0, "cam"))
-
-
-def test_compensation_turns_body_bearings_into_the_route_frame():
-    ahead = np.array([[1.0, 0.0, 0.0]])
-    assert np.allclose(compensate(ahead, np.pi / 2), [[0.0, 1.0, 0.0]])  # facing +y, "ahead" is +y
 
 
 def test_bad_updates_are_refused():

@@ -1,0 +1,91 @@
+"""maps.ltmap.prune: cutting the lowest level, worked out by hand on small trees, and budgets."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from maps.ltmap.arrays import IDS
+from maps.ltmap.prune import cut_lowest_level, follow
+from maps.ltmap.tree import LandmarkTree
+from tests.maps.ltmap_trees import Rows
+
+SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+def test_start_and_goal_keep_their_leaf_a_weak_viewframe_goes_and_a_shared_end_merges():
+    # root 0; nodes 1, 2, 3 under it; leaves 4 (start), 5, 6, 7 (goal) under 1, 2, 3, 3
+    parent = [-1, 0, 0, 0, 1, 2, 3, 3]
+    rows = np.array([0, 1, 1, 2, 3, 3, 3, 4, 5, 5, 6, 7, 7])
+    cut = cut_lowest_level(parent, [4, 5, 6, 7], rows, min_landmarks=3)
+    # start's row 7 moves up to node 1, goal's rows 11-12 to node 3; rows 8-10 (inner leaves) are cut;
+    # viewframes 2 and 3 now both end in node 3 (merged); viewframe 1 keeps 2 landmarks < 3 (deleted,
+    # and node 2 with its row 3)
+    assert cut.landmark_index.tolist() == [0, 1, 2, -1, 3, 4, 5, 6, -1, -1, -1, 7, 8]
+    assert cut.viewframe_index.tolist() == [0, -1, 1, 1]
+    assert (cut.merged, cut.deleted) == (1, 1)
+    assert cut.node_parent == [-1, 0, 0] and cut.viewframe_leaves == [1, 2]  # nodes 0, 1, 3 renumbered
+    assert cut.landmark_nodes.tolist() == [0, 1, 1, 2, 2, 2, 1, 2, 2]
+
+
+def test_viewframes_left_with_the_same_landmarks_are_merged():
+    # root 0 (2 rows); empty nodes 1-4 under it; leaves 5-8, one row each
+    cut = cut_lowest_level([-1, 0, 0, 0, 0, 1, 2, 3, 4], [5, 6, 7, 8], np.array([0, 0, 5, 6, 7, 8]),
+                           min_landmarks=0)
+    # viewframes 1 and 2 are left with the root's landmarks only: one viewframe, the earlier
+    assert cut.viewframe_index.tolist() == [0, 1, 1, 2] and (cut.merged, cut.deleted) == (1, 0)
+    assert cut.node_parent == [-1, 0, 0, 0] and cut.viewframe_leaves == [1, 2, 3]
+    assert cut.landmark_index.tolist() == [0, 1, 2, -1, -1, 3] and cut.landmark_nodes.tolist() == [0, 0, 1, 3]
+
+
+def test_a_root_with_one_child_merges_into_it():
+    # root 0, its only child 1, leaves 2 (start) and 3 (goal): after the cut both end in node 1
+    cut = cut_lowest_level([-1, 0, 1, 1], [2, 3], np.array([0, 1, 2, 3]), min_landmarks=0)
+    assert cut.node_parent == [-1] and cut.viewframe_leaves == [0]  # height 2 -> 0
+    assert cut.landmark_nodes.tolist() == [0, 0, 0, 0] and cut.landmark_index.tolist() == [0, 1, 2, 3]
+    assert cut.viewframe_index.tolist() == [0, 0] and cut.merged == 1
+
+
+def test_indices_follow_through_steps():
+    assert follow(np.array([0, 2, -1, 1]), np.array([1, -1, 0])).tolist() == [1, 0, -1, -1]
+
+
+def small_tree(views: int = 5) -> LandmarkTree:
+    rows, tree = Rows(np.random.default_rng(7)), LandmarkTree(IDS)
+    for _ in range(views):
+        last = tree.viewframe(-1).landmarks if tree.viewframe_count else np.zeros(0, dtype=np.int64)
+        tracked = last[: len(last) // 2]
+        tree.add_viewframe(tracked, rows.make(tree.bearings[tracked]), rows.random(20))
+    return tree
+
+
+def test_a_budget_is_met_by_whole_levels_or_the_map_is_left_as_it_was():
+    tree = small_tree()
+    before = tree.memory_bytes()
+    report = tree.prune_to(before - 1, min_landmarks=0)
+    assert report.fits and report.levels_cut >= 1 and tree.memory_bytes() == report.bytes_after < before
+    assert report.bytes_before == before and len(report.viewframe_index) == 5
+    arrays = tree.to_arrays()
+    failed = tree.prune_to(10, min_landmarks=0)
+    assert not failed.fits and failed.levels_cut == 0 and failed.smallest_bytes > 10
+    assert all(np.array_equal(arrays[k], v) for k, v in tree.to_arrays().items())  # unchanged
+    assert failed.landmark_index.tolist() == list(range(tree.landmark_count))
+
+
+@SETTINGS
+@given(st.integers(0, 2**32 - 1), st.integers(1, 12))
+def test_memory_never_grows_under_pruning_and_reaches_height_zero(seed, views):
+    rng = np.random.default_rng(seed)
+    tree, rows = LandmarkTree(IDS), Rows(rng)
+    for _ in range(views):
+        last = tree.viewframe(-1).landmarks if tree.viewframe_count else np.zeros(0, dtype=np.int64)
+        tracked = last[rng.random(len(last)) < 0.6]
+        tree.add_viewframe(tracked, rows.make(tree.bearings[tracked]), rows.random(int(rng.integers(0, 40))))
+    sizes = [tree.memory_bytes()]
+    while tree.prune_level(int(rng.integers(0, 40))) is not None:
+        sizes.append(tree.memory_bytes())
+    assert all(a > b for a, b in zip(sizes, sizes[1:], strict=False))
+    assert tree.height == 0 and len(sizes) - 1 <= views
+
+
