@@ -21,12 +21,11 @@ class Equals(BearingsBehaviour):
     """SUCCESS when ``value`` equals ``equals`` (two literals, e.g. an input and a choice), else FAILURE."""
 
     KIND = "condition"
-    PORTS = (
-        InputPort("value", str, literal_only=True, doc="the value chosen (usually a ${input})"),
-        InputPort("equals", str, literal_only=True, doc="the value this branch is for"),
-    )
+    VALUE = InputPort("value", str, literal_only=True, doc="the value chosen (usually a ${input})")
+    EQUALS = InputPort("equals", str, literal_only=True, doc="the value this branch is for")
+    PORTS = (VALUE, EQUALS)
 
     def update(self) -> Status:
-        same = self.get_input("value") == self.get_input("equals")
-        self.feedback_message = "" if same else f"{self.get_input('value')!r} is not {self.get_input('equals')!r}"
-        return Status.SUCCESS if same else Status.FAILURE
+        value, equals = self.get_input(self.VALUE), self.get_input(self.EQUALS)
+        self.feedback_message = "" if value == equals else f"{value!r} is not {equals!r}"
+        return Status.SUCCESS if value == equals else Status.FAILURE

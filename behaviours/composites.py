@@ -21,7 +21,8 @@ class RecoveryNode(Declared, py_trees.composites.Composite):
     """
 
     KIND = "composite"
-    PORTS = (InputPort("number_of_retries", int, 1, minimum=0, literal_only=True, doc="recoveries to try"),)
+    NUMBER_OF_RETRIES = InputPort("number_of_retries", int, 1, minimum=0, literal_only=True, doc="recoveries to try")
+    PORTS = (NUMBER_OF_RETRIES,)
     CHILDREN = (2, 2)
 
     def __init__(
@@ -30,7 +31,7 @@ class RecoveryNode(Declared, py_trees.composites.Composite):
         if len(children) != 2:
             raise ValueError("RecoveryNode takes exactly two children: the task and its recovery")
         super().__init__(name=name, children=children)
-        self.number_of_retries = int(number_of_retries)
+        self.number_of_retries = number_of_retries
         self.retries = 0
         self._in_recovery = False
 

@@ -6,7 +6,7 @@ from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
 from behaviours.comparison import compare
-from behaviours.decorators import GUARD_PORTS
+from behaviours.decorators import GUARD_KEY, GUARD_OP, GUARD_PORTS, GUARD_VALUE
 from behaviours.ports import InputPort, Ref
 from behaviours.registry import register
 
@@ -19,7 +19,7 @@ class CheckBlackboard(BearingsBehaviour):
     PORTS = GUARD_PORTS
 
     def update(self) -> Status:
-        key, op, value = self.inputs["key"], self.inputs["op"], self.inputs["value"]
+        key, op, value = self.get_input(GUARD_KEY), self.get_input(GUARD_OP), self.get_input(GUARD_VALUE)
         try:
             current = self.bb.get(key)
         except KeyError:
@@ -35,7 +35,8 @@ class IsStalled(BearingsBehaviour):
     """SUCCESS while the base reports a stalled wheel (a collision), FAILURE otherwise."""
 
     KIND = "condition"
-    PORTS = (InputPort("stalled", bool, Ref("/robot/stalled"), doc="the base's stall flag"),)
+    STALLED = InputPort("stalled", bool, Ref("/robot/stalled"), doc="the base's stall flag")
+    PORTS = (STALLED,)
 
     def update(self) -> Status:
-        return Status.SUCCESS if self.get_input("stalled", False) else Status.FAILURE
+        return Status.SUCCESS if self.get_input(self.STALLED, False) else Status.FAILURE

@@ -52,12 +52,11 @@ class Parallel(Declared, py_trees.composites.Parallel):
     """Tick every child each tick; FAILURE as soon as one fails."""
 
     KIND = "composite"
-    PORTS = (
-        InputPort("policy", str, "all", choices=("all", "one"), literal_only=True,
-                  doc="all: SUCCESS when every child succeeded; one: when any did"),
-        InputPort("synchronise", bool, True, literal_only=True,
-                  doc="with policy all: do not re-tick children that succeeded"),
-    )
+    POLICY = InputPort("policy", str, "all", choices=("all", "one"), literal_only=True,
+                       doc="all: SUCCESS when every child succeeded; one: when any did")
+    SYNCHRONISE = InputPort("synchronise", bool, True, literal_only=True,
+                            doc="with policy all: do not re-tick children that succeeded")
+    PORTS = (POLICY, SYNCHRONISE)
     CHILDREN = (1, None)
 
     def __init__(self, name: str, children: list[Behaviour], policy: str = "all", synchronise: bool = True
@@ -73,7 +72,8 @@ class Retry(Declared, py_trees.decorators.Retry):
     """Restart the child after a failure, up to num_attempts attempts."""
 
     KIND = "decorator"
-    PORTS = (InputPort("num_attempts", int, minimum=1, literal_only=True, doc="attempts before giving up"),)
+    NUM_ATTEMPTS = InputPort("num_attempts", int, minimum=1, literal_only=True, doc="attempts before giving up")
+    PORTS = (NUM_ATTEMPTS,)
     BTCPP = "RetryUntilSuccessful"
     CHILDREN = (1, 1)
 
@@ -86,7 +86,8 @@ class Repeat(Declared, py_trees.decorators.Repeat):
     """Run the child again after each success, num_cycles times; FAILURE on a failure."""
 
     KIND = "decorator"
-    PORTS = (InputPort("num_cycles", int, minimum=-1, literal_only=True, doc="successes needed; -1 repeats forever"),)
+    NUM_CYCLES = InputPort("num_cycles", int, minimum=-1, literal_only=True, doc="successes needed; -1 repeats forever")
+    PORTS = (NUM_CYCLES,)
     CHILDREN = (1, 1)
 
     def __init__(self, name: str, child: Behaviour, num_cycles: int) -> None:
@@ -122,8 +123,9 @@ class OneShot(Declared, py_trees.decorators.OneShot):
     """Run the child to completion once, then keep returning that result."""
 
     KIND = "decorator"
-    PORTS = (InputPort("policy", str, "on_success", choices=("on_success", "on_completion"), literal_only=True,
-                       doc="latch after the first success, or after the first completion"),)
+    POLICY = InputPort("policy", str, "on_success", choices=("on_success", "on_completion"), literal_only=True,
+                       doc="latch after the first success, or after the first completion")
+    PORTS = (POLICY,)
     BTCPP = "RunOnce"
     CHILDREN = (1, 1)
 

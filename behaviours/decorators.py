@@ -58,11 +58,12 @@ class Timeout(_ClockedDecorator):
     never ticked after its time is up.
     """
 
-    PORTS = (InputPort("duration", float, unit="s", minimum=0.0, literal_only=True, doc="time limit in tree time"),)
+    DURATION = InputPort("duration", float, unit="s", minimum=0.0, literal_only=True, doc="time limit in tree time")
+    PORTS = (DURATION,)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, duration: float) -> None:
         super().__init__(name=name, child=child)
-        self.duration = float(duration)
+        self.duration = duration
         self._deadline = 0.0
 
     def initialise(self) -> None:
@@ -88,11 +89,12 @@ class RateController(_ClockedDecorator):
     only when the period has elapsed (Nav2's RateController throttles the same way).
     """
 
-    PORTS = (InputPort("hz", float, unit="Hz", minimum=1e-6, literal_only=True, doc="highest tick rate of the child"),)
+    HZ = InputPort("hz", float, unit="Hz", minimum=1e-6, literal_only=True, doc="highest tick rate of the child")
+    PORTS = (HZ,)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, hz: float) -> None:
         super().__init__(name=name, child=child)
-        self.period = 1.0 / float(hz)
+        self.period = 1.0 / hz
         self._last_tick: float | None = None
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
@@ -107,12 +109,12 @@ class RateController(_ClockedDecorator):
         yield from self._tick_child()
 
 
-GUARD_PORTS = (
-    InputPort("key", Key, literal_only=True, doc="blackboard key (absolute), optionally with an attribute: "
-              "/robot/odometry.x"),
-    InputPort("op", str, "==", choices=COMPARISONS, literal_only=True, doc="comparison"),
-    InputPort("value", object, literal_only=True, doc="the value to compare with"),
-)
+GUARD_KEY = InputPort("key", Key, literal_only=True, doc="blackboard key (absolute), optionally with an attribute: "
+                      "/robot/odometry.x")
+GUARD_OP = InputPort("op", str, "==", choices=COMPARISONS, literal_only=True, doc="comparison")
+GUARD_VALUE = InputPort("value", object, literal_only=True, doc="the value to compare with")
+GUARD_PORTS = (GUARD_KEY, GUARD_OP, GUARD_VALUE)
+"""``key op value``: the condition of a ``Guard`` and of a ``CheckBlackboard``."""
 
 
 @register

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
@@ -24,22 +26,22 @@ class Perceive(BearingsBehaviour):
     under the mission's ``sense:``.
     """
 
-    PORTS = (
-        InputPort("camera", str, "", doc="camera name; empty: the first camera", literal_only=True),
-        InputPort("features", str, "orb", doc="detector", choices=available_kinds(), literal_only=True),
-        InputPort("max_features", int, 500, doc="most features per frame", minimum=10, maximum=10000,
-                  literal_only=True),
-        InputPort("frames", dict, Ref("/perception/frames"), doc="the latest frame of each camera, by name"),
-        OutputPort("observation", Observation, "/perception/observation", doc="bearings and features or ids"),
-    )
+    CAMERA = InputPort("camera", str, "", doc="camera name; empty: the first camera", literal_only=True)
+    FEATURES = InputPort("features", str, "orb", doc="detector", choices=available_kinds(), literal_only=True)
+    MAX_FEATURES = InputPort("max_features", int, 500, doc="most features per frame", minimum=10, maximum=10000,
+                             literal_only=True)
+    FRAMES = InputPort("frames", dict, Ref("/perception/frames"), doc="the latest frame of each camera, by name")
+    OBSERVATION = OutputPort("observation", Observation, "/perception/observation",
+                             doc="bearings and features or ids")
+    PORTS = (CAMERA, FEATURES, MAX_FEATURES, FRAMES, OBSERVATION)
 
-    def __init__(self, name: str | None = None, **params) -> None:
+    def __init__(self, name: str | None = None, **params: Any) -> None:
         super().__init__(name=name, **params)
         self._last_stamp: tuple[str, float] | None = None
 
     def update(self) -> Status:
-        name = self.get_input("camera")
-        frames = self.get_input("frames", None) or {}
+        name = self.get_input(self.CAMERA)
+        frames = self.get_input(self.FRAMES, None) or {}
         frame = frames.get(name) if name else next(iter(frames.values()), None)
         if frame is None:
             self.feedback_message = f"no frame from {name or 'the camera'} yet"
@@ -50,8 +52,8 @@ class Perceive(BearingsBehaviour):
             if isinstance(frame, LandmarkBearings):
                 observation = from_landmark_bearings(frame)
             else:
-                observation = observe(frame, kind=self.get_input("features"),
-                                      n_features=self.get_input("max_features"))
-            self.set_output("observation", observation)
+                observation = observe(frame, kind=self.get_input(self.FEATURES),
+                                      n_features=self.get_input(self.MAX_FEATURES))
+            self.set_output(self.OBSERVATION, observation)
             self.feedback_message = f"{observation.count} landmarks"
         return Status.SUCCESS

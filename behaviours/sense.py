@@ -36,26 +36,26 @@ class _Sensor(BearingsBehaviour):
 class ReadOdometry(_Sensor):
     """Copy the base's odometry and stall flag to ``/robot``."""
 
-    PORTS = (
-        OutputPort("odometry", Pose2D, "/robot/odometry", doc="odometry pose of the base (drifts)"),
-        OutputPort("stalled", bool, "/robot/stalled", doc="a wheel is stalled (collision)"),
-    )
+    ODOMETRY = OutputPort("odometry", Pose2D, "/robot/odometry", doc="odometry pose of the base (drifts)")
+    STALLED = OutputPort("stalled", bool, "/robot/stalled", doc="a wheel is stalled (collision)")
+    PORTS = (ODOMETRY, STALLED)
 
     def update(self) -> Status:
         base = self.robot.base
-        self.set_output("odometry", base.odometry())
-        self.set_output("stalled", bool(base.stalled()))
+        self.set_output(self.ODOMETRY, base.odometry())
+        self.set_output(self.STALLED, bool(base.stalled()))  # a driver may answer with a numpy bool
         return Status.SUCCESS
 
 
 class ReadPanTilt(_Sensor):
     """Copy the pan-tilt unit's state to ``/ptu/state`` (SUCCESS without doing anything if none)."""
 
-    PORTS = (OutputPort("state", PanTiltState, "/ptu/state", doc="pan/tilt position and motion"),)
+    STATE = OutputPort("state", PanTiltState, "/ptu/state", doc="pan/tilt position and motion")
+    PORTS = (STATE,)
 
     def update(self) -> Status:
         if self.robot.ptu is not None:
-            self.set_output("state", self.robot.ptu.state())
+            self.set_output(self.STATE, self.robot.ptu.state())
         return Status.SUCCESS
 
 
@@ -67,10 +67,10 @@ class GrabFrames(_Sensor):
     previous one (its stamp tells how old it is).
     """
 
-    PORTS = (
-        OutputPort("frames", dict, "/perception/frames", doc="latest frame of each camera, by camera name"),
-        OutputPort("frame", Frame | LandmarkBearings, "/perception/frame", doc="latest frame of the first camera"),
-    )
+    FRAMES = OutputPort("frames", dict, "/perception/frames", doc="latest frame of each camera, by camera name")
+    FRAME: OutputPort[Frame | LandmarkBearings] = OutputPort("frame", Frame | LandmarkBearings, "/perception/frame",
+                                                             doc="latest frame of the first camera")
+    PORTS = (FRAMES, FRAME)
 
     def __init__(self, name: str | None = None, *, cameras: tuple[str, ...] | None = None) -> None:
         super().__init__(name=name)
@@ -92,17 +92,17 @@ class GrabFrames(_Sensor):
         if not cameras:
             return Status.SUCCESS
         try:
-            frames = dict(self.bb.get(self.output_key("frames")))
+            frames = dict(self.bb.get(self.output_key(self.FRAMES)))  # what it wrote last tick
         except KeyError:
             frames = {}
         for name, camera in cameras.items():
             frame = camera.grab()
             if frame is not None:
                 frames[name] = frame
-        self.set_output("frames", frames)
+        self.set_output(self.FRAMES, frames)
         primary = next(iter(cameras))
         if primary in frames:
-            self.set_output("frame", frames[primary])
+            self.set_output(self.FRAME, frames[primary])
         return Status.SUCCESS
 
 

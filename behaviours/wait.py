@@ -13,10 +13,11 @@ from behaviours.registry import register
 class Wait(BearingsBehaviour):
     """RUNNING for ``duration`` seconds of tree time, then SUCCESS (the robot is not driven)."""
 
-    PORTS = (InputPort("duration", float, unit="s", doc="how long to wait", minimum=0.0),)
+    DURATION = InputPort("duration", float, unit="s", doc="how long to wait", minimum=0.0)
+    PORTS = (DURATION,)
 
     def initialise(self) -> None:
-        self._until = self.now() + float(self.get_input("duration"))
+        self._until = self.now() + self.get_input(self.DURATION)
 
     def update(self) -> Status:
         remaining = self._until - self.now()

@@ -23,7 +23,7 @@ def waypoint_pairs(flat: list[float]) -> list[tuple[float, float]]:
     """``[x0, y0, x1, y1, ...]`` as points; ValueError for an odd count."""
     if len(flat) % 2:
         raise ValueError(f"waypoints come as x, y pairs: got {len(flat)} numbers")
-    return [(float(flat[i]), float(flat[i + 1])) for i in range(0, len(flat), 2)]
+    return [(flat[i], flat[i + 1]) for i in range(0, len(flat), 2)]
 
 
 @register
@@ -34,16 +34,14 @@ class DriveWaypoints(OdometryMotion):
     leg goes on straight; the robot stops and turns where the route bends by more than 30 deg.
     """
 
-    PORTS = (
-        InputPort("waypoints", list[float], unit="m", doc="x0, y0, x1, y1, ... in the odometry frame"),
-        InputPort("speed", float, 0.3, unit="m/s", minimum=0.01, maximum=1.2, doc="top speed"),
-        InputPort("tolerance", float, 0.05, unit="m", minimum=0.005, doc="how close a waypoint is reached"),
-        *MOTION_PORTS,
-    )
+    WAYPOINTS = InputPort("waypoints", list[float], unit="m", doc="x0, y0, x1, y1, ... in the odometry frame")
+    SPEED = InputPort("speed", float, 0.3, unit="m/s", minimum=0.01, maximum=1.2, doc="top speed")
+    TOLERANCE = InputPort("tolerance", float, 0.05, unit="m", minimum=0.005, doc="how close a waypoint is reached")
+    PORTS = (WAYPOINTS, SPEED, TOLERANCE, *MOTION_PORTS)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
-        self.points = waypoint_pairs(list(self.get_input("waypoints")))
+        self.points = waypoint_pairs(self.get_input(self.WAYPOINTS))
         if not self.points:
             raise ValueError(f"{self.name}: no waypoints")
         self.index = 0
@@ -52,7 +50,7 @@ class DriveWaypoints(OdometryMotion):
         self.index = 0
 
     def step(self, pose: Pose2D) -> Status:
-        tolerance = float(self.get_input("tolerance"))
+        tolerance = self.get_input(self.TOLERANCE)
         while self.index < len(self.points) and math.dist((pose.x, pose.y), self.points[self.index]) <= tolerance:
             self.index += 1
         if self.index >= len(self.points):
@@ -63,7 +61,7 @@ class DriveWaypoints(OdometryMotion):
         error = wrap_angle(math.atan2(y - pose.y, x - pose.x) - pose.theta)
         w = ramp(error, math.radians(60.0), ANGULAR_DECEL, 0.0) if error else 0.0
         remaining = distance + self._straight_on(self.index)
-        v = 0.0 if abs(error) > DriveTo.TURN_IN_PLACE else ramp(remaining, float(self.get_input("speed")),
+        v = 0.0 if abs(error) > DriveTo.TURN_IN_PLACE else ramp(remaining, self.get_input(self.SPEED),
                                                                  LINEAR_DECEL, MIN_SPEED) * math.cos(error)
         self.command(v, w)
         self.feedback_message = f"waypoint {self.index + 1} of {len(self.points)}: {distance:.2f} m to go"

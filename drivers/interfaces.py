@@ -7,7 +7,7 @@ mission cannot tell them apart. Units are SI: metres, seconds, radians.
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
@@ -97,6 +97,23 @@ class Camera(Protocol):
 
     def close(self) -> None:
         """Release the device."""
+
+
+@runtime_checkable
+class KeySource(Protocol):
+    """Keys typed by an operator (teleoperation); ``read`` never blocks."""
+
+    def read(self) -> list[str]:
+        """The keys typed since the last call, oldest first (possibly none): ``up``, ``space``, ``q``, ..."""
+
+    def close(self) -> None:
+        """Give the input back (restore the terminal)."""
+
+
+KeyboardOpener = Callable[[], KeySource]
+"""Opens the operator's keyboard when a node first needs it (OSError: there is none). The runner
+hands one to the tree at setup (``setup(keyboard=...)``), so nothing is opened unless a node that
+drives by keys runs."""
 
 
 @dataclass

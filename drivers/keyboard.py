@@ -6,6 +6,10 @@ returns the keys typed since the last call, polling with a zero timeout. Arrow k
 escape sequences and come out as ``up``, ``down``, ``left``, ``right``; space is ``space``,
 Enter is ``enter``, other keys their lower-case character. The terminal's settings are restored
 by :meth:`close` (and at exit, should nobody call it).
+
+Behaviours never import this module: the runner hands the tree an opener
+(:data:`~drivers.interfaces.KeyboardOpener`) at setup, and a node that drives by keys opens the
+terminal through it when it first runs.
 """
 
 from __future__ import annotations
@@ -15,22 +19,10 @@ import contextlib
 import os
 import select
 import sys
-from typing import Protocol, runtime_checkable
 
 ESCAPES = {"\x1b[A": "up", "\x1b[B": "down", "\x1b[C": "right", "\x1b[D": "left",
            "\x1bOA": "up", "\x1bOB": "down", "\x1bOC": "right", "\x1bOD": "left"}
 NAMED = {" ": "space", "\n": "enter", "\r": "enter", "\x1b": "escape"}
-
-
-@runtime_checkable
-class KeySource(Protocol):
-    """Keys typed by an operator; ``read`` never blocks."""
-
-    def read(self) -> list[str]:
-        """The keys typed since the last call, oldest first (possibly none)."""
-
-    def close(self) -> None:
-        """Give the input back (restore the terminal)."""
 
 
 def parse_keys(text: str) -> list[str]:
@@ -50,7 +42,11 @@ def parse_keys(text: str) -> list[str]:
 
 
 class TerminalKeys:
-    """The keys of the controlling terminal on standard input (OSError when it is not a terminal)."""
+    """The keys of the controlling terminal on standard input (OSError when it is not a terminal).
+
+    A :class:`~drivers.interfaces.KeySource`; the class itself is the runner's
+    :data:`~drivers.interfaces.KeyboardOpener` (constructing it opens the terminal).
+    """
 
     def __init__(self, fd: int | None = None) -> None:
         import termios

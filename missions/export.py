@@ -170,27 +170,21 @@ def _one_shot(node: NodeSpec) -> Translation:
     return "OneShot", {"policy": "on_success"}  # BT.CPP lacks it: declared in the TreeNodesModel
 
 
-def _script(node: NodeSpec) -> str | None:
-    return comparison_script(node.inputs["key"], node.inputs["op"], node.inputs["value"])
-
-
-def _guard(node: NodeSpec) -> Translation:
-    script = _script(node)
-    if script is None:
-        return f"Guard.value {node.inputs['value']!r} cannot be written in a BehaviorTree.CPP script"
-    return "Precondition", {"if": script, "else": "FAILURE"}
-
-
-def _check(node: NodeSpec) -> Translation:
-    script = _script(node)
-    if script is None:
-        return f"CheckBlackboard.value {node.inputs['value']!r} cannot be written in a BehaviorTree.CPP script"
-    return "ScriptCondition", {"code": script}
+def _scripted(tag: str, script_port: str, others: Attributes) -> Callable[[NodeSpec], Translation]:
+    """A comparison ``key op value`` as BT.CPP's script node ``tag`` (Guard: ``Precondition if``,
+    CheckBlackboard: ``ScriptCondition code``), with its ``others`` ports."""
+    def translate(node: NodeSpec) -> Translation:
+        script = comparison_script(node.inputs["key"], node.inputs["op"], node.inputs["value"])
+        if script is None:
+            return f"{node.type}.value {node.inputs['value']!r} cannot be written in a BehaviorTree.CPP script"
+        return tag, {script_port: script, **others}
+    return translate
 
 
 TRANSLATIONS: dict[str, Callable[[NodeSpec], Translation]] = {
     "Sequence": _memory("Sequence"), "Selector": _memory("Fallback"), "Parallel": _parallel, "Timeout": _timeout,
-    "OneShot": _one_shot, "Guard": _guard, "CheckBlackboard": _check,
+    "OneShot": _one_shot, "Guard": _scripted("Precondition", "if", {"else": "FAILURE"}),
+    "CheckBlackboard": _scripted("ScriptCondition", "code", {}),
 }  # fmt: skip
 """bearings' control nodes whose ports differ from their BT.CPP counterpart's."""
 

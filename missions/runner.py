@@ -1,8 +1,10 @@
 """Run a mission: tick the tree at a fixed rate, turn its commands into driver calls, stop safely.
 
 The tree is a py_trees :class:`~py_trees.trees.BehaviourTree`: its ``setup`` hands every node the
-clock and the drivers, a pre-tick handler clears the command keys (a command lives for the tick
-that wrote it), post-tick handlers dispatch the commands to the drivers and record the tick.
+clock, the drivers and the operator's keyboard (an opener,
+:data:`~drivers.interfaces.KeyboardOpener`: the terminal by default, opened only by a node that
+drives by keys when it runs), a pre-tick handler clears the command keys (a command lives for the
+tick that wrote it), post-tick handlers dispatch the commands to the drivers and record the tick.
 Between ticks the runner calls ``clock.next_tick(period)``: on a robot that waits for wall
 time, in the simulator it steps the world (the simulator is a driver the clock steps), so the
 loop has no simulation branch. Whatever ends the run, the report is written:
@@ -47,7 +49,8 @@ from py_trees.common import Status
 from behaviours.clock import TickClock
 from behaviours.keys import COMMAND_KEYS, input_key
 from behaviours.telemetry import Draws, Reports, Sections, section
-from drivers.interfaces import STOP, PanTiltCommand, Robot, VelocityCommand
+from drivers.interfaces import STOP, KeyboardOpener, PanTiltCommand, Robot, VelocityCommand
+from drivers.keyboard import TerminalKeys
 from maps.store import write_json
 from missions.builder import build_root
 from missions.clocks import WallClock
@@ -108,9 +111,11 @@ class Runner:
         options: RunOptions | None = None,
         observers: Sequence[RunObserver] = (),
         on_tick: Callable[[Runner], None] | None = None,
+        keyboard: KeyboardOpener = TerminalKeys,
     ) -> None:
         self.mission = mission
         self.robot = robot
+        self.keyboard = keyboard  # opened by a node that drives by keys, when it first runs
         self.options = options or RunOptions()
         self.clock: TickClock = clock or WallClock()
         self.observers = tuple(observers)
@@ -172,7 +177,8 @@ class Runner:
                                       timeline=self.clock.timeline)
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
-        self.tree.setup(clock=self.clock, robot=self.robot)  # hand every node the clock and the drivers
+        # hand every node the clock and the drivers (the keyboard as an opener: a terminal is taken only if used)
+        self.tree.setup(clock=self.clock, robot=self.robot, keyboard=self.keyboard)
         self._drawers = [node for node in self.root.iterate() if isinstance(node, Reports | Draws)
                          or callable(getattr(node, "log_rerun", None))]
 

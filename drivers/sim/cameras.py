@@ -19,7 +19,7 @@ import numpy as np
 from drivers.sim.render import CameraRenderer
 from drivers.sim.scene import Scene
 from drivers.sim.sensors import BearingSensorModel, observe_landmarks
-from drivers.sim.world import CameraSpec, Lighting, PtuSpec
+from drivers.sim.world_values import CameraSpec, Lighting, PtuSpec
 from perception.camera import StereoRig
 from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D, rot_pitch, rot_z

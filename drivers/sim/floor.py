@@ -1,7 +1,7 @@
 """The reachable free floor of a simulated world: the reference for "how much was explored".
 
 The walls, box outlines (filled: a box is solid) and pillars of a
-:class:`~drivers.sim.world.World` are rasterised at ``resolution`` (``cv2`` lines, polygons and
+:class:`~drivers.sim.world_values.World` are rasterised at ``resolution`` (``cv2`` lines, polygons and
 circles, on cell centres), the robot's radius is inflated around them with a Euclidean distance
 transform, and the cells its centre can reach from the start pose are one connected component
 (``scipy.ndimage.label``, 4-connected). Two masks come out:
@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from drivers.sim.world import World
+from drivers.sim.world_values import World
 
 _SHIFT = 4  # sub-cell precision (bits) of the cv2 drawing
 

@@ -8,7 +8,7 @@ from collections.abc import Callable
 import numpy as np
 
 from drivers.interfaces import PanTiltState
-from drivers.sim.world import PtuSpec
+from drivers.sim.world_values import PtuSpec
 
 
 class SimPanTilt:

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from drivers.sim.textures import AtlasBuilder, Region, make_sky, make_texture
-from drivers.sim.world import TextureSpec, World
+from drivers.sim.world_values import TextureSpec, World
+from perception.geometry import Pose2D
 
 EPS = 1e-9
 SKY_PX_PER_RAD = 60.0  # texels per radian of the sky / far-ground bands
@@ -34,7 +35,7 @@ class ColumnHits:
 
 
 class Scene:
-    """Segments, circles, landmarks and the texture atlas of one :class:`~drivers.sim.world.World`."""
+    """Segments, circles, landmarks and the texture atlas of one :class:`~drivers.sim.world_values.World`."""
 
     def __init__(self, world: World) -> None:
         self.world = world
@@ -293,6 +294,19 @@ class Scene:
     def collides(self, x: float, y: float, radius: float) -> bool:
         """Whether a robot disc of ``radius`` at (x, y) touches any wall, box face or pillar."""
         return self.clearance(x, y) < radius
+
+
+def free_space_problem(world: World, pose: Pose2D) -> str | None:
+    """Why the robot cannot stand at ``pose`` (too close to a wall, box or pillar), or None.
+
+    The world loader checks the start pose with it, ``bearings run --start`` a pose given on the
+    command line.
+    """
+    clearance = Scene(world).clearance(pose.x, pose.y)
+    if clearance >= world.robot_radius:
+        return None
+    return (f"({pose.x:g}, {pose.y:g}) is not in free space: {max(clearance, 0.0):.2f} m from a wall, box or "
+            f"pillar, less than the robot radius {world.robot_radius:g} m")
 
 
 def _surface_texture(spec: TextureSpec, length: float, height: float) -> np.ndarray:

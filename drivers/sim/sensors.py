@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drivers.sim.scene import Scene
-from drivers.sim.world import CameraSpec
+from drivers.sim.world_values import CameraSpec
 from perception.frame import LandmarkBearings
 
 

@@ -29,7 +29,8 @@ from drivers.sim.kinematics import DiffDrive, DiffDriveLimits, SlipModel
 from drivers.sim.ptu import SimPanTilt
 from drivers.sim.scene import Scene
 from drivers.sim.visualise import RerunLogger
-from drivers.sim.world import World, empty_world, load_world
+from drivers.sim.world import load_world
+from drivers.sim.world_values import World, empty_world
 from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
 
@@ -205,6 +206,10 @@ class Simulation:
     def odometry_in_world(self) -> np.ndarray:
         """Where odometry believes the robot is, as world (x, y): odometry starts at the true start."""
         return _start_to_world(self.truth.true[0], np.asarray(self.truth.odometry[-1:])[:, 1:3])[0]
+
+    def true_trajectory(self) -> np.ndarray:
+        """The whole true trajectory as world (x, y) rows."""
+        return np.asarray(self.truth.true)[:, 1:3]
 
     def odometry_trajectory_in_world(self) -> np.ndarray:
         """The whole odometry trajectory as world (x, y) rows."""

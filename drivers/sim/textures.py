@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from drivers.sim.world import TextureSpec
+from drivers.sim.world_values import TextureSpec
 
 PAD = 2  # texels of clamped border around each texture: bilinear sampling never bleeds
 MAX_ATLAS_WIDTH = 16384  # cv2.remap needs coordinates below 32767

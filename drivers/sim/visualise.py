@@ -1,27 +1,51 @@
 """Logging a simulation to rerun: the world from above, trajectories, camera images, pan-tilt view.
 
-The runner calls :meth:`RerunLogger.log` once per tick after ``rr.set_time(...)``. The world is
-logged once (static); poses are two points per tick; the trajectories are re-logged as line
-strips only every ``trail_every`` ticks (decimated), and camera images only every
+The simulation calls :meth:`RerunLogger.log` once per recorded tick, handing itself in as the
+:class:`Simulated` it is (this module does not know the simulation, only what it reads of it).
+The world is logged once (static); poses are two points per tick; the trajectories are re-logged
+as line strips only every ``trail_every`` ticks (decimated), and camera images only every
 ``image_every`` ticks and only when the camera grabbed a new frame: logging never renders.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from collections.abc import Mapping
+from typing import Any, Protocol
 
 import numpy as np
 
+from drivers.sim.cameras import SimCamera
+from drivers.sim.ptu import SimPanTilt
+from drivers.sim.world_values import World
 from perception.frame import Frame
-
-if TYPE_CHECKING:
-    from drivers.sim.simulation import Simulation
+from perception.geometry import Pose2D
 
 WALL_COLOUR = (200, 200, 200)
 TRUE_COLOUR = (60, 200, 60)
 ODOM_COLOUR = (230, 120, 40)
 LANDMARK_COLOUR = (80, 140, 255)
+
+
+class Simulated(Protocol):
+    """What the logger reads of a simulation (:class:`drivers.sim.simulation.Simulation` is one)."""
+
+    @property
+    def world(self) -> World: ...
+
+    @property
+    def ptu(self) -> SimPanTilt | None: ...
+
+    @property
+    def cameras(self) -> Mapping[str, SimCamera]: ...
+
+    def true_pose(self) -> Pose2D: ...
+
+    def odometry_in_world(self) -> np.ndarray: ...
+
+    def true_trajectory(self) -> np.ndarray: ...
+
+    def odometry_trajectory_in_world(self) -> np.ndarray: ...
 
 
 class RerunLogger:
@@ -35,7 +59,7 @@ class RerunLogger:
         self._world_logged = False
         self._image_stamps: dict[str, float] = {}
 
-    def log(self, sim: Simulation, rec: Any) -> None:
+    def log(self, sim: Simulated, rec: Any) -> None:
         """Log this tick; ``rec`` is the ``rerun`` module or a ``rerun.RecordingStream``."""
         import rerun as rr
 
@@ -63,7 +87,7 @@ class RerunLogger:
             )
         if self._ticks % self.trail_every == 0:
             for name, rows, colour in (
-                ("true", np.asarray(sim.truth.true)[:, 1:3], TRUE_COLOUR),
+                ("true", sim.true_trajectory(), TRUE_COLOUR),
                 ("odometry", sim.odometry_trajectory_in_world(), ODOM_COLOUR),
             ):
                 if len(rows) > self.max_trail:
@@ -81,7 +105,7 @@ class RerunLogger:
         self._ticks += 1
 
     @staticmethod
-    def _log_world(sim: Simulation, rec: Any, rr: Any) -> None:
+    def _log_world(sim: Simulated, rec: Any, rr: Any) -> None:
         world = sim.world
         strips = [np.asarray(w.points) for w in world.walls]
         for p in world.pillars:

@@ -1,20 +1,21 @@
-"""Simulated worlds: the values a world file describes, and the validating loader.
+"""Loading a simulated world: shipped worlds by name, world files checked into :class:`World` values.
 
-A world is a flat floor with vertical surfaces on it (wall polylines, boxes, round pillars), point
-landmarks anywhere in 3D, a ceiling or an open sky, the robot's start and named poses, its pan-tilt
-unit and cameras, and the lighting. The file format is declared in :mod:`drivers.sim.world_file`
-and documented in ``docs/worlds.md``. Files are read through :mod:`maps.store` only, and every
+The file format is declared in :mod:`drivers.sim.world_file` and documented in ``docs/worlds.md``;
+the values it becomes are :mod:`drivers.sim.world_values` (re-exported here: ``World`` and
+``load_world`` come from one place). Files are read through :mod:`maps.store` only, and every
 problem of a file is reported at once as an :class:`~maps.store.InputError` with
-``file:line:col`` diagnostics, like missions.
+``file:line:col`` diagnostics, like missions. What needs the whole world is checked after the
+entries (duplicate ids and names, cameras under the ceiling, a start pose in free space: the last
+one with the simulator's geometry, :func:`drivers.sim.scene.free_space_problem`).
 
-Units: metres in the file and in here; angles are degrees in the file (keys end in ``_deg``) and
-radians in these values.
+Units: metres in the file and in the values; angles are degrees in the file (keys end in
+``_deg``) and radians in the values.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -22,187 +23,27 @@ from typing import Any
 from pydantic import ValidationError
 
 from drivers.sim import world_file as wf
+from drivers.sim.scene import free_space_problem
+from drivers.sim.world_values import (
+    CameraSpec,
+    Landmark,
+    Lighting,
+    MountPose,
+    Pillar,
+    PtuSpec,
+    TextureSpec,
+    Wall,
+    World,
+    default_cameras,
+    empty_world,
+)
 from maps.located import describe_value, diagnose
 from maps.store import Diagnostic, InputError, Mark, YamlList, YamlMap, load_yaml, mark_of
-from perception.camera import PanoramaCamera, PinholeCamera, StereoRig, camera_from_dict
 from perception.geometry import Pose2D
 
 FORMAT_VERSION = wf.FORMAT_VERSION
 CAMERA_KINDS = ("bearings", "panorama", "catadioptric", "pinhole", "stereo")
 MOUNTS = ("base", "ptu")
-
-
-@dataclass(frozen=True, slots=True)
-class TextureSpec:
-    """How a surface's procedural texture is generated: seed, resolution and feature size."""
-
-    seed: int
-    pixels_per_m: float = 60.0
-    feature_size: float = 0.2  # m, typical size of a painted shape
-    brightness: float = 128.0  # mean grey level
-    contrast: float = 1.0
-
-
-@dataclass(frozen=True, slots=True)
-class Wall:
-    """A vertical textured surface along a polyline from the floor up to ``height``.
-
-    ``two_sided`` walls are visible from both sides (free-standing walls); the faces of boxes are
-    one-sided (their insides are never seen).
-    """
-
-    points: tuple[tuple[float, float], ...]
-    height: float
-    texture: TextureSpec
-    two_sided: bool = True
-
-
-@dataclass(frozen=True, slots=True)
-class Pillar:
-    """A vertical cylinder standing on the floor."""
-
-    x: float
-    y: float
-    radius: float
-    height: float
-    texture: TextureSpec
-
-
-@dataclass(frozen=True, slots=True)
-class Landmark:
-    """A point landmark (for the ``bearings`` sensor; drawn as a small disc in images)."""
-
-    id: int
-    x: float
-    y: float
-    z: float
-    size: float = 0.1  # m, diameter of the drawn disc
-
-
-@dataclass(frozen=True, slots=True)
-class MountPose:
-    """Where a camera sits on its mount (base frame, or pan-tilt head frame), REP-103 axes."""
-
-    x: float = 0.0
-    y: float = 0.0
-    z: float = 0.0
-    yaw: float = 0.0
-    pitch: float = 0.0  # rad, positive looks up
-
-
-@dataclass(frozen=True, slots=True)
-class PtuSpec:
-    """The pan-tilt unit: where it sits on the base, its limits and its top slew rate.
-
-    Defaults are those of a Directed Perception PTU-D46-17 (+-159 deg pan, -47/+31 deg tilt,
-    300 deg/s).
-    """
-
-    x: float = 0.1
-    y: float = 0.0
-    z: float = 1.0
-    pan_limits: tuple[float, float] = (math.radians(-159.0), math.radians(159.0))
-    tilt_limits: tuple[float, float] = (math.radians(-47.0), math.radians(31.0))
-    max_speed: float = math.radians(300.0)
-
-
-@dataclass(frozen=True, slots=True)
-class CameraSpec:
-    """One simulated camera: kind, mount, pose on the mount, model and imperfections.
-
-    ``model`` is a :mod:`perception.camera` model for image cameras and None for ``bearings``.
-    The ``bearings`` sensor uses ``noise`` (rad, per axis), ``azimuth_fov`` (rad, centred on the
-    camera x axis), ``elevation_limits`` (rad) and ``max_range`` (m).
-    """
-
-    name: str
-    kind: str
-    mount: str = "base"
-    pose: MountPose = MountPose(z=0.9)
-    model: Any = None
-    frame_drop: float = 0.0  # probability that grab() returns None
-    exposure_noise: float = 0.0  # relative sigma of the per-frame gain, plus pixel noise
-    noise: float = 0.0
-    azimuth_fov: float = 2.0 * math.pi
-    elevation_limits: tuple[float, float] = (math.radians(-60.0), math.radians(60.0))
-    max_range: float = math.inf
-
-
-@dataclass(frozen=True, slots=True)
-class Lighting:
-    """Global brightness: ``out = gain * in + bias``; ``run_variation`` draws a new gain per seed."""
-
-    gain: float = 1.0
-    bias: float = 0.0
-    run_variation: float = 0.0
-
-
-@dataclass(frozen=True, slots=True)
-class World:
-    """Everything a world file describes (see ``docs/worlds.md``)."""
-
-    name: str
-    seed: int = 0
-    walls: tuple[Wall, ...] = ()
-    pillars: tuple[Pillar, ...] = ()
-    landmarks: tuple[Landmark, ...] = ()
-    ceiling: float | None = None  # m; None: open sky
-    floor: TextureSpec = TextureSpec(seed=0, pixels_per_m=25.0, feature_size=0.25, contrast=0.6)
-    ground_margin: float = 10.0
-    start: Pose2D = Pose2D()
-    poses: dict[str, Pose2D] = field(default_factory=dict)
-    robot_radius: float = 0.26
-    ptu: PtuSpec = PtuSpec()
-    cameras: tuple[CameraSpec, ...] = ()
-    lighting: Lighting = Lighting()
-    source: str = "<builtin>"
-
-    def camera(self, name: str) -> CameraSpec:
-        for spec in self.cameras:
-            if spec.name == name:
-                return spec
-        raise KeyError(f"no camera {name!r} in world {self.name!r} (has: {', '.join(self.camera_names)})")
-
-    @property
-    def camera_names(self) -> tuple[str, ...]:
-        return tuple(spec.name for spec in self.cameras)
-
-    def bounds(self) -> tuple[float, float, float, float]:
-        """(xmin, ymin, xmax, ymax) of walls, pillars, start and poses (landmarks excluded)."""
-        xs = [self.start.x, *(p.x for p in self.poses.values())]
-        ys = [self.start.y, *(p.y for p in self.poses.values())]
-        for wall in self.walls:
-            xs += [p[0] for p in wall.points]
-            ys += [p[1] for p in wall.points]
-        for p in self.pillars:
-            xs += [p.x - p.radius, p.x + p.radius]
-            ys += [p.y - p.radius, p.y + p.radius]
-        return min(xs), min(ys), max(xs), max(ys)
-
-
-def default_cameras() -> tuple[CameraSpec, ...]:
-    """The camera set of a world file without ``cameras``: one of each kind.
-
-    ``panorama`` (720 x 172 at 0.5 deg/px) and ``omni`` (its raw catadioptric donut) on a mast on
-    the base, ``landmarks`` (ideal bearings), and on the pan-tilt unit a ``front`` pinhole and a
-    ``stereo`` pair (12 cm baseline).
-    """
-    mast = MountPose(z=0.9)
-    head = MountPose(x=0.05, z=0.08)
-    pinhole = PinholeCamera(640, 480, 525.0, 525.0, 319.5, 239.5, (-0.05, 0.01, 0.0, 0.0))
-    rect = PinholeCamera(640, 480, 525.0, 525.0, 319.5, 239.5)
-    return (
-        CameraSpec("panorama", "panorama", "base", mast, PanoramaCamera()),
-        CameraSpec("omni", "catadioptric", "base", mast, camera_from_dict({"kind": "catadioptric"})),
-        CameraSpec("landmarks", "bearings", "base", mast, None, noise=math.radians(0.5), max_range=100.0),
-        CameraSpec("front", "pinhole", "ptu", head, pinhole),
-        CameraSpec("stereo", "stereo", "ptu", head, StereoRig(rect, rect, 0.12)),
-    )
-
-
-def empty_world() -> World:
-    """An empty plane under an open sky, with the default cameras and no landmarks."""
-    return World(name="empty", cameras=default_cameras())
 
 
 # --------------------------------------------------------------------------------------------
@@ -368,17 +209,6 @@ def _whole_world_problems(world: World, data: YamlMap, file: str) -> list[Diagno
     return problems or _start_problems(world, data, file)
 
 
-def free_space_problem(world: World, pose: Pose2D) -> str | None:
-    """Why the robot cannot stand at ``pose`` (too close to a wall, box or pillar), or None."""
-    from drivers.sim.scene import Scene  # the scene is built from a World: imported here, not at the top
-
-    clearance = Scene(world).clearance(pose.x, pose.y)
-    if clearance >= world.robot_radius:
-        return None
-    return (f"({pose.x:g}, {pose.y:g}) is not in free space: {max(clearance, 0.0):.2f} m from a wall, box or "
-            f"pillar, less than the robot radius {world.robot_radius:g} m")
-
-
 def _start_problems(world: World, data: YamlMap, file: str) -> list[Diagnostic]:
     problem = free_space_problem(world, world.start)
     if problem is None:
@@ -389,8 +219,6 @@ def _start_problems(world: World, data: YamlMap, file: str) -> list[Diagnostic]:
 
 def _camera_height(spec: CameraSpec, ptu: PtuSpec) -> float:
     return spec.pose.z + (ptu.z if spec.mount == "ptu" else 0.0)
-
-
 
 
 def _box_outline(center: tuple[float, ...], size: tuple[float, ...], yaw: float) -> tuple[tuple[float, float], ...]:

@@ -166,7 +166,7 @@ def _start_pose(text: str | None, world: Any) -> Pose2D | None:
     """The ``--start`` pose in the world (named or x,y,theta), checked to be in free space."""
     if text is None:
         return None
-    from drivers.sim.world import free_space_problem
+    from drivers.sim.scene import free_space_problem
 
     try:
         pose = parse_pose(text, {"start": world.start, **world.poses}, option="--start")

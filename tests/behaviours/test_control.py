@@ -1,34 +1,14 @@
-"""Decorators and composites of the mission language, on the manual clock."""
+"""The control nodes of behaviours/control.py: py_trees' semantics under the mission language's names."""
 
 from __future__ import annotations
 
-import py_trees
 import pytest
 from py_trees.common import Status
 
-from behaviours.base import NotSetUp
-from behaviours.composites import RecoveryNode
-from behaviours.decorators import Guard, RateController, Timeout
+from behaviours.control import MEMORY, OneShot, Parallel, Repeat, Retry, Selector, Sequence
 from behaviours.registry import Registry
 from behaviours.testing import BehaviourHarness
-
-
-class Scripted(py_trees.behaviour.Behaviour):
-    """Returns the statuses it is given, one per tick (the last one repeats); counts ticks."""
-
-    def __init__(self, *statuses: Status, name: str = "scripted") -> None:
-        super().__init__(name=name)
-        self.statuses = list(statuses)
-        self.ticks = 0
-        self.halts = 0
-
-    def update(self) -> Status:
-        self.ticks += 1
-        return self.statuses.pop(0) if len(self.statuses) > 1 else self.statuses[0]
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID:
-            self.halts += 1
+from tests.behaviours.scripted import Scripted
 
 
 def _build(type_name: str, **kwargs):
@@ -36,92 +16,21 @@ def _build(type_name: str, **kwargs):
     return Registry.builtin().lookup(type_name).cls(**kwargs)
 
 
-def test_timeout_uses_the_tree_clock_and_halts_the_child():
-    child = Scripted(Status.RUNNING)
-    harness = BehaviourHarness(Timeout(name="t", child=child, duration=5.0))
-    assert harness.tick() == Status.RUNNING
-    harness.clock.advance(4.9)
-    assert harness.tick() == Status.RUNNING
-    harness.clock.advance(0.1)
-    assert harness.tick() == Status.FAILURE
-    assert child.ticks == 2 and child.halts == 1  # not ticked once the time was up
-    assert "timed out after 5 s" in harness.behaviour.feedback_message
-
-
-def test_timeout_restarts_after_completion():
-    child = Scripted(Status.SUCCESS)
-    harness = BehaviourHarness(Timeout(name="t", child=child, duration=1.0))
-    assert harness.tick() == Status.SUCCESS
-    harness.clock.advance(10.0)
-    assert harness.tick() == Status.SUCCESS  # a fresh deadline for a fresh run
-
-
-def test_timeout_without_a_clock_is_a_clear_error():
-    timeout = Timeout(name="t", child=Scripted(Status.RUNNING), duration=1.0)
-    with pytest.raises(NotSetUp, match="no clock"):
-        timeout.tick_once()
-
-
-def test_rate_controller_limits_child_ticks():
-    child = Scripted(Status.RUNNING)
-    harness = BehaviourHarness(RateController(name="r", child=child, hz=2.0))
-    for _ in range(20):  # 2 s at 10 Hz
-        assert harness.tick() == Status.RUNNING
-        harness.clock.advance(0.1)
-    assert child.ticks == 4
-
-
-def test_rate_controller_passes_completion_up():
-    harness = BehaviourHarness(RateController(name="r", child=Scripted(Status.RUNNING, Status.SUCCESS), hz=10.0))
-    assert harness.tick() == Status.RUNNING
-    harness.clock.advance(0.1)
-    assert harness.tick() == Status.SUCCESS
-
-
-def test_recovery_node_retries_after_recovery():
-    task = Scripted(Status.FAILURE, Status.FAILURE, Status.SUCCESS, name="task")
-    recovery = Scripted(Status.SUCCESS, name="recovery")
-    harness = BehaviourHarness(RecoveryNode(name="rec", children=[task, recovery], number_of_retries=3))
-    assert harness.tick() == Status.SUCCESS  # fail, recover, fail, recover, succeed: all in one tick
-    assert (task.ticks, recovery.ticks) == (3, 2)
-
-
-def test_recovery_node_gives_up_after_the_retries():
-    task, recovery = Scripted(Status.FAILURE, name="task"), Scripted(Status.SUCCESS, name="recovery")
-    harness = BehaviourHarness(RecoveryNode(name="rec", children=[task, recovery], number_of_retries=2))
-    assert harness.tick() == Status.FAILURE
-    assert (task.ticks, recovery.ticks) == (3, 2)
-    assert harness.behaviour.feedback_message == "failed after 2 recoveries"
-
-
-def test_recovery_node_fails_when_recovery_fails_and_waits_while_running():
-    task = Scripted(Status.FAILURE, name="task")
-    recovery = Scripted(Status.RUNNING, Status.FAILURE, name="recovery")
-    harness = BehaviourHarness(RecoveryNode(name="rec", children=[task, recovery], number_of_retries=5))
-    assert harness.tick() == Status.RUNNING
-    assert harness.tick() == Status.FAILURE
-    assert task.ticks == 1  # the task is not retried while its recovery runs
-
-
-def test_guard_ticks_child_only_while_condition_holds():
-    child = Scripted(Status.RUNNING)
-    harness = BehaviourHarness(Guard(name="g", child=child, key="/robot/stalled", op="==", value=False),
-                               blackboard={"/robot/stalled": False})
-    assert harness.tick() == Status.RUNNING
-    harness.write("/robot/stalled", True)
-    assert harness.tick() == Status.FAILURE
-    assert child.ticks == 1 and child.halts == 1
-
-
 @pytest.mark.parametrize(
     ("name", "params", "child_status", "expected"),
-    [("Inverter", {}, Status.SUCCESS, Status.FAILURE), ("ForceSuccess", {}, Status.FAILURE, Status.SUCCESS),
-     ("ForceFailure", {}, Status.SUCCESS, Status.FAILURE), ("Retry", {"num_attempts": 3}, Status.FAILURE,
-                                                              Status.RUNNING)],
+    [("Inverter", {}, Status.SUCCESS, Status.FAILURE), ("Inverter", {}, Status.FAILURE, Status.SUCCESS),
+     ("ForceSuccess", {}, Status.FAILURE, Status.SUCCESS), ("ForceFailure", {}, Status.SUCCESS, Status.FAILURE),
+     ("Retry", {"num_attempts": 3}, Status.FAILURE, Status.RUNNING)],
 )
 def test_registered_decorators_map_to_py_trees_semantics(name, params, child_status, expected):
     node = _build(name, name=name, child=Scripted(child_status), **params)
     assert BehaviourHarness(node).tick() == expected
+
+
+@pytest.mark.parametrize(("name", "expected"), [("Success", Status.SUCCESS), ("Failure", Status.FAILURE),
+                                                ("Running", Status.RUNNING)])
+def test_the_constant_leaves(name, expected):
+    assert BehaviourHarness(_build(name, name=name)).tick() == expected
 
 
 def test_retry_gives_up_after_its_attempts():
@@ -137,6 +46,11 @@ def test_repeat_counts_cycles():
     assert [harness.tick() for _ in range(3)] == [Status.RUNNING, Status.RUNNING, Status.SUCCESS]
 
 
+def test_repeat_fails_on_a_failure():
+    harness = BehaviourHarness(Repeat(name="r", child=Scripted(Status.SUCCESS, Status.FAILURE), num_cycles=5))
+    assert [harness.tick() for _ in range(2)] == [Status.RUNNING, Status.FAILURE]
+
+
 def test_sequence_memory_default_resumes_at_running_child():
     first, second = Scripted(Status.SUCCESS, name="a"), Scripted(Status.RUNNING, name="b")
     seq = _build("Sequence", name="s", children=[first, second], memory=True)
@@ -149,3 +63,59 @@ def test_sequence_memory_default_resumes_at_running_child():
     reactive.tick()
     reactive.tick()
     assert (first2.ticks, second2.ticks) == (2, 2)
+
+
+def test_sequence_fails_at_the_first_failure():
+    first, second = Scripted(Status.FAILURE, name="a"), Scripted(Status.SUCCESS, name="b")
+    assert BehaviourHarness(Sequence(name="s", children=[first, second])).tick() == Status.FAILURE
+    assert second.ticks == 0
+
+
+def test_selector_falls_back_until_a_child_does_not_fail():
+    first, second, third = (Scripted(Status.FAILURE, name="a"), Scripted(Status.SUCCESS, name="b"),
+                            Scripted(Status.SUCCESS, name="c"))
+    assert BehaviourHarness(Selector(name="f", children=[first, second, third])).tick() == Status.SUCCESS
+    assert (first.ticks, second.ticks, third.ticks) == (1, 1, 0)
+    assert Selector.BTCPP == "Fallback" and Selector.PORTS == Sequence.PORTS == (MEMORY,)
+
+
+@pytest.mark.parametrize(("policy", "expected"), [("all", Status.RUNNING), ("one", Status.SUCCESS)])
+def test_parallel_succeeds_when_all_or_one_child_did(policy, expected):
+    done, busy = Scripted(Status.SUCCESS, name="done"), Scripted(Status.RUNNING, name="busy")
+    node = Parallel(name="p", children=[done, busy], policy=policy)
+    assert BehaviourHarness(node).tick() == expected and node.policy_name == policy
+
+
+def test_parallel_fails_as_soon_as_one_child_fails():
+    failing, busy = Scripted(Status.FAILURE, name="fails"), Scripted(Status.RUNNING, name="busy")
+    assert BehaviourHarness(Parallel(name="p", children=[failing, busy])).tick() == Status.FAILURE
+
+
+def test_parallel_synchronised_does_not_tick_a_child_that_succeeded_again():
+    done, busy = Scripted(Status.SUCCESS, name="done"), Scripted(Status.RUNNING, Status.SUCCESS, name="busy")
+    harness = BehaviourHarness(Parallel(name="p", children=[done, busy], synchronise=True))
+    assert [harness.tick(), harness.tick()] == [Status.RUNNING, Status.SUCCESS] and done.ticks == 1
+    again, slow = Scripted(Status.SUCCESS, name="again"), Scripted(Status.RUNNING, Status.SUCCESS, name="slow")
+    loose = BehaviourHarness(Parallel(name="p", children=[again, slow], synchronise=False))
+    assert [loose.tick(), loose.tick()] == [Status.RUNNING, Status.SUCCESS] and again.ticks == 2
+
+
+@pytest.mark.parametrize("policy", ["on_success", "on_completion"])
+def test_one_shot_latches_a_success(policy):
+    child = Scripted(Status.SUCCESS)
+    harness = BehaviourHarness(OneShot(name="o", child=child, policy=policy))
+    assert [harness.tick(), harness.tick()] == [Status.SUCCESS, Status.SUCCESS] and child.ticks == 1
+
+
+def test_one_shot_on_success_retries_a_failure_but_on_completion_keeps_it():
+    retried = Scripted(Status.FAILURE, Status.SUCCESS)
+    harness = BehaviourHarness(OneShot(name="o", child=retried, policy="on_success"))
+    assert [harness.tick(), harness.tick()] == [Status.FAILURE, Status.SUCCESS] and retried.ticks == 2
+    kept = Scripted(Status.FAILURE, Status.SUCCESS)
+    latched = BehaviourHarness(OneShot(name="o", child=kept, policy="on_completion"))
+    assert [latched.tick(), latched.tick()] == [Status.FAILURE, Status.FAILURE] and kept.ticks == 1
+
+
+def test_retry_and_oneshot_are_named_as_in_behaviortree_cpp():
+    assert (Retry.BTCPP, OneShot.BTCPP) == ("RetryUntilSuccessful", "RunOnce")
+    assert [p.name for p in Parallel.PORTS] == ["policy", "synchronise"]

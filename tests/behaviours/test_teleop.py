@@ -1,29 +1,36 @@
-"""KeyboardTeleop with a fake key source, the key parser, DriveWaypoints on an ideal base."""
+"""KeyboardTeleop (behaviours/teleop.py) with a fake keyboard handed in at setup, as the runner hands the terminal."""
 
 from __future__ import annotations
 
 import math
-import os
 
 import pytest
 from py_trees.common import Status
 
+from behaviours.base import NotSetUp
 from behaviours.teleop import KeyboardTeleop
 from behaviours.testing import BehaviourHarness
-from behaviours.waypoints import DriveWaypoints, waypoint_pairs
 from drivers.fake import FakeKeys
 from drivers.interfaces import STOP
-from drivers.keyboard import TerminalKeys, parse_keys
-from perception.geometry import Pose2D
-from tests.behaviours.test_motion import integrate
 
 
-def teleop(batches: list[list[str]], **ports) -> tuple[BehaviourHarness, FakeKeys]:
-    keys = FakeKeys(batches)
+class Opener:
+    """A keyboard opener that counts how often the keyboard was opened."""
+
+    def __init__(self, keys: FakeKeys) -> None:
+        self.keys, self.opened = keys, 0
+
+    def __call__(self) -> FakeKeys:
+        self.opened += 1
+        return self.keys
+
+
+def teleop(batches: list[list[str]], **ports) -> tuple[BehaviourHarness, Opener]:
+    opener = Opener(FakeKeys(batches))
     node = KeyboardTeleop(**ports)
     harness = BehaviourHarness(node)
-    node.setup(clock=harness.clock, keys=keys)  # the key source is handed in at setup
-    return harness, keys
+    node.setup(clock=harness.clock, keyboard=opener)  # as the runner does: setup(keyboard=...)
+    return harness, opener
 
 
 def test_arrow_keys_and_wasd_drive_and_space_stops():
@@ -46,47 +53,36 @@ def test_the_robot_stops_when_keys_stop_arriving_for_the_timeout():
     assert moving == [True] * 6 + [False] * 2  # 0.0 .. 0.5 s after the key, then stopped
 
 
-def test_q_or_enter_ends_the_drive():
+def test_q_or_enter_ends_the_drive_and_gives_the_keyboard_back():
     for key in ("q", "enter"):
-        harness, _ = teleop([["up"], [key]])
+        harness, opener = teleop([["up"], [key]])
         harness.tick()
         assert harness.tick() == Status.SUCCESS and harness.read("/robot/command") == STOP
+        assert opener.opened == 1 and opener.keys.closed
 
 
-def test_without_a_terminal_the_node_fails_and_never_blocks():
-    read, write = os.pipe()  # not a terminal
-    try:
-        with pytest.raises(OSError, match="not a terminal"):
-            TerminalKeys(read)
-    finally:
-        os.close(read)
-        os.close(write)
+def test_the_keyboard_is_opened_only_when_the_node_runs():
+    harness, opener = teleop([["up"]])
+    assert opener.opened == 0  # set up, not run: the terminal is not taken
+    harness.tick()
+    harness.tick()
+    assert opener.opened == 1
+    harness.halt()  # a higher-priority branch takes over: the keyboard is given back
+    assert opener.keys.closed and harness.behaviour.keys is None
 
 
-def test_parse_keys_names_arrows_and_specials():
-    assert parse_keys("\x1b[A\x1b[Dw \nQ\x1bOB") == ["up", "left", "w", "space", "enter", "q", "down"]
+def test_without_a_terminal_the_node_fails_stopped():
+    def no_terminal() -> FakeKeys:
+        raise OSError("standard input is not a terminal: run the mission from a terminal to drive with keys")
+
+    node = KeyboardTeleop()
+    harness = BehaviourHarness(node)
+    node.setup(keyboard=no_terminal)
+    assert harness.tick() == Status.FAILURE and harness.read("/robot/command") == STOP
+    assert "not a terminal" in node.feedback_message
 
 
-def test_drive_waypoints_passes_every_point_and_stops_at_the_last():
-    harness = BehaviourHarness(DriveWaypoints(waypoints=[1.0, 0.0, 1.0, 1.0, 0.0, 1.0]),
-                               blackboard={"/robot/odometry": Pose2D()})
-    visited = []
-
-    def step(h: BehaviourHarness) -> None:
-        integrate(h)
-        visited.append(h.read("/robot/odometry"))
-
-    assert harness.tick_until(between=step) == Status.SUCCESS
-    for x, y in waypoint_pairs([1.0, 0.0, 1.0, 1.0, 0.0, 1.0]):
-        assert min(math.hypot(p.x - x, p.y - y) for p in visited) < 0.06
-    assert harness.read("/robot/command") == STOP
-    with pytest.raises(ValueError, match="pairs"):
-        waypoint_pairs([1.0, 2.0, 3.0])
-
-
-def test_equals_chooses_a_branch_at_load_time():
-    from behaviours.choice import Equals
-
-    assert BehaviourHarness(Equals(value="keyboard", equals="keyboard")).tick() == Status.SUCCESS
-    chosen = BehaviourHarness(Equals(value="waypoints", equals="keyboard"))
-    assert chosen.tick() == Status.FAILURE and "'waypoints' is not 'keyboard'" in chosen.behaviour.feedback_message
+def test_a_tree_set_up_without_a_keyboard_is_a_clear_error():
+    harness = BehaviourHarness(KeyboardTeleop())
+    with pytest.raises(NotSetUp, match="no keyboard"):
+        harness.tick()

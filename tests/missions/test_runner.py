@@ -249,3 +249,28 @@ def test_nodes_add_report_sections_and_recordings(write_mission, tmp_path):
                     options=RunOptions(save_path=tmp_path / "run.rrd")).run()
     assert result.status == "SUCCESS"
     assert result.report["counting"] == {"ticks": 5, "logged": 5}
+
+
+def test_the_runner_hands_the_tree_a_keyboard_opened_only_by_a_node_that_drives_by_keys(write_mission):
+    from drivers.fake import FakeKeys
+
+    opened: list[FakeKeys] = []
+
+    def keyboard() -> FakeKeys:
+        opened.append(FakeKeys([["up"], ["up"], ["q"]]))
+        return opened[-1]
+
+    unused = _mission(write_mission, """
+        Selector:
+          children:
+            - Success
+            - KeyboardTeleop
+    """)
+    assert Runner(unused, fake_robot(), clock=ManualClock(), keyboard=keyboard).run().status == "SUCCESS"
+    assert opened == []  # the teleop node never ran: the keyboard was never opened
+    robot = fake_robot()
+    driven = _mission(write_mission, "KeyboardTeleop: {speed: 0.25}\n")
+    result = Runner(driven, robot, clock=ManualClock(), keyboard=keyboard).run()
+    assert result.status == "SUCCESS" and result.reason == "mission tree succeeded"
+    assert robot.base.commands[:2] == [(0.25, 0.0), (0.25, 0.0)] and robot.base.commands[-1] == (0.0, 0.0)
+    assert len(opened) == 1 and opened[0].closed  # opened once, given back when the drive ended
