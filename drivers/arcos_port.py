@@ -128,6 +128,7 @@ class ArcosPort:
         time.sleep(BAUD_SETTLE_S)
         self._serial.baudrate = target
         time.sleep(BAUD_SETTLE_S)
+        self.forget_input()  # a packet that arrived at the old speed proves nothing (ARIA takes it)
         end = time.monotonic() + BAUD_PROOF_S
         while time.monotonic() < end:
             self.send(arcos.encode_command(Command.PULSE))
