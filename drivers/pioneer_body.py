@@ -12,18 +12,22 @@ Per model (the subclass the robot reports in SYNC2), from ARIA's public ``params
   ``RobotRadius``; bit ``i + 1`` of the SIP's bumper byte is bumper ``i``.
 
 The sonar cone and range limits are those of the Pioneer's Polaroid-type transducers as ARIA
-uses them (``ArSonarDevice``: readings beyond 5 m are ignored).
+uses them (``ArSonarDevice``: readings beyond 5 m are ignored). :meth:`PioneerBody.scan` turns
+the driver's newest readings into the :class:`~perception.ranges.RangeScan` the collision monitor
+reads (``PioneerBase.range_source()``): a reading of 5 m or more is no echo (``inf``), a
+transducer not heard for the driver's ``sonar_timeout`` (or never) is no data (``nan``).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from perception.polygons import rectangle
-from perception.ranges import Bumper, RangeSensor
+from perception.ranges import Bumper, RangeScan, RangeSensor
 
 SONAR_FOV = math.radians(30.0)  # the transducer's cone
 SONAR_MAX_RANGE = 5.0  # m: ArSonarDevice's default maximum; farther (or 5000 mm: no echo) is no echo
@@ -63,6 +67,37 @@ class PioneerBody:
                 angle = math.radians(degrees)
                 out.append(Bumper(self.radius * math.cos(angle), self.radius * math.sin(angle), facing))
         return tuple(out)
+
+    def scan(self, sonar: Mapping[int, float], silent: Collection[int], front_bits: int, rear_bits: int,
+             stamp: float, *, with_sonar: bool = True) -> RangeScan:
+        """The ring's readings (m, by transducer number; ``silent``: not heard lately) and the SIP's
+        bumper bits (bit ``i``: bumper ``i``) as one scan; without sonar, the bumpers alone."""
+        sensors = self.sensors() if with_sonar else ()
+        ranges = np.full(len(sensors), np.nan)
+        for index, metres in sonar.items():
+            if index < len(sensors) and index not in silent:
+                ranges[index] = np.inf if metres >= SONAR_MAX_RANGE else metres
+        pressed = [bool(front_bits >> i & 1) for i in range(self.front_bumpers)]
+        pressed += [bool(rear_bits >> i & 1) for i in range(self.rear_bumpers)]
+        return RangeScan(sensors, ranges, stamp, self.bumpers(), np.array(pressed, dtype=bool))
+
+
+class PioneerRanges:
+    """The :class:`~drivers.interfaces.RangeSource` of a Pioneer base: its newest scan, read from the
+    base's I/O thread's latest SIP (closing it releases nothing: the base owns the port)."""
+
+    def __init__(self, scan: Callable[[], RangeScan | None], description: str) -> None:
+        self._scan = scan
+        self._description = description
+
+    def read(self) -> RangeScan | None:
+        return self._scan()
+
+    def close(self) -> None:
+        pass
+
+    def describe(self) -> str:
+        return self._description
 
 
 _P3DX_SONAR = ((69, 136, 90), (114, 119, 50), (148, 78, 30), (166, 27, 10), (166, -27, -10), (148, -78, -30),
