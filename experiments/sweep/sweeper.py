@@ -297,8 +297,9 @@ class _Workspace:
             shutil.rmtree(self._scratch, ignore_errors=True)
         if self.journal is not None and self.folder is not None:
             self.journal.close()
-            rows = latest_by_id(read_rows(self.folder / TABLE))
-            write_sorted(self.folder / TABLE, rows.values())
+            # the table holds what it held at the start (``existing``) and the rows appended since
+            # (``recorded``): sorted from memory, not read again
+            write_sorted(self.folder / TABLE, latest_by_id([*self.existing.values(), *self.recorded]).values())
         self._unlock()
 
     def record(self, episode: Episode, result: EpisodeResult) -> Row:

@@ -153,6 +153,18 @@ def test_resume_skips_recorded_episodes_and_a_torn_row_is_ignored(tmp_path, caps
     assert capsys.readouterr().out.splitlines()[1].split()[:3] == ["square", "empty", "3"]
 
 
+def test_the_table_ends_with_one_row_per_episode_the_last_written_sorted(tmp_path):
+    folder = tmp_path / "out"
+    episodes = grid("square", ["empty"], [0, 1], {"side": [0.1]}, max_time_s=30)
+    first = run_sweep(episodes[1:], results_dir=folder)
+    table = folder / "results.jsonl"
+    stale = json.dumps({**first[0], "status": "ERROR", "reason": "an earlier try"})
+    table.write_text(stale + "\n" + table.read_text())  # the same episode, an older row before it
+    rows = run_sweep(episodes, results_dir=folder, resume=True)
+    assert [r["seed"] for r in rows] == [0, 1] and rows[1] == first[0]
+    assert rows_of(folder) == json.loads(json.dumps(rows, default=str))
+
+
 def test_journal_writes_whole_lines_and_cuts_a_torn_tail(tmp_path):
     path = tmp_path / "results.jsonl"
     path.write_bytes(b'{"id":"a","x":1}\n{"id":"b","x"')
