@@ -39,8 +39,10 @@ import numpy as np
 
 from behaviours.exploration import unpack_cells
 from drivers.sim.floor import FloorGrid, reachable_floor
+from drivers.sim.simulation import start_to_world
 from drivers.sim.world import load_world
 from experiments.eval import EvalOptions
+from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.table import read_report
 from maps.exploration import GridFrame, StereoHead, scan_cells
@@ -85,29 +87,11 @@ def variant_of(inputs: dict[str, Any]) -> str:
 # What was seen, at the true poses
 
 
-class TrueTrajectory:
-    """The report's ground-truth trajectory (t, x, y, theta rows, world frame), interpolated in time."""
-
-    def __init__(self, rows: Sequence[Sequence[float]]) -> None:
-        a = np.asarray(rows, dtype=np.float64).reshape(-1, 4)
-        self.t, self.xy = a[:, 0], a[:, 1:3]
-        self.theta = np.unwrap(a[:, 3])
-        steps = np.hypot(*np.diff(self.xy, axis=0).T) if len(a) > 1 else np.zeros(0)
-        self.length = np.concatenate(([0.0], np.cumsum(steps)))
-
-    def pose(self, t: float) -> Pose2D:
-        x, y = (float(np.interp(t, self.t, self.xy[:, i])) for i in (0, 1))
-        return Pose2D(x, y, float(np.interp(t, self.t, self.theta)))
-
-    def path_length(self, t: float) -> float:
-        return float(np.interp(t, self.t, self.length))
-
-
 def seen_floor(report: dict[str, Any], floor: FloorGrid, robot_radius: float) -> tuple[np.ndarray, np.ndarray]:
     """The cells (bool, the floor grid's) seen at the true poses, and the coverage curve as rows of
     (time s, true path length m, coverage of the reachable floor), in time order."""
     exploration, truth = report.get("exploration", {}), report["ground_truth"]
-    trajectory = TrueTrajectory(truth["trajectory"])
+    trajectory = TrueTrajectory(truth)
     frame = GridFrame(floor.x0, floor.y0, floor.resolution, *floor.reachable.shape)
     seen = np.zeros(frame.shape, dtype=np.uint8)
     disc = int(round(robot_radius / floor.resolution))
@@ -127,7 +111,7 @@ def seen_floor(report: dict[str, Any], floor: FloorGrid, robot_radius: float) ->
             rows, cols, _ = floor.cells_of(trajectory.xy[item])
             cv2.circle(seen, (int(cols[0]), int(rows[0])), disc, 1, -1)
         else:
-            view = head.view(trajectory.pose(t), float(item[1]), float(item[2]))
+            view = head.view(trajectory.interpolated(t), float(item[1]), float(item[2]))
             seen |= scan_cells(frame, view, edges, np.asarray(item[3:], dtype=np.float64)).astype(np.uint8)
             curve.append((t, trajectory.path_length(t), np.count_nonzero(seen.astype(bool) & floor.reachable) / total))
     coverage = np.count_nonzero(seen.astype(bool) & floor.reachable) / total
@@ -147,8 +131,7 @@ def map_in_world(report: dict[str, Any]) -> np.ndarray:
     offsets = np.array([(a, b) for a in sub for b in sub]) * frame.resolution
     local = (frame.centre_of(rows, cols)[:, None, :] + offsets[None, :, :]).reshape(-1, 2)
     _, x0, y0, th0 = report["ground_truth"]["trajectory"][0]
-    c, s = math.cos(th0), math.sin(th0)
-    return np.column_stack((x0 + c * local[:, 0] - s * local[:, 1], y0 + s * local[:, 0] + c * local[:, 1]))
+    return start_to_world(Pose2D(x0, y0, th0), local)
 
 
 def _first(curve: np.ndarray, level: float, column: int) -> float | None:

@@ -58,6 +58,7 @@ from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
 from experiments.eval.figures import cell, mean_present
 from experiments.eval.ltmap_route import Route, default_route, given_route, parse_route
+from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.table import read_report
 from maps.ltmap import DEFAULT_MIN_LANDMARKS, LandmarkTree
@@ -207,58 +208,60 @@ def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_
 # Figures
 
 
-class Trajectory:
-    """A report's ground-truth trajectory (t, x, y, theta rows, world frame)."""
+@dataclass(frozen=True)
+class Run:
+    """A run's report with its true trajectory, read once: a teach's serves every repeat of its map."""
 
-    def __init__(self, report: Mapping[str, Any]) -> None:
-        rows = np.asarray(report["ground_truth"]["trajectory"], dtype=np.float64).reshape(-1, 4)
-        self.t, self.xy = rows[:, 0], rows[:, 1:3]
+    report: Mapping[str, Any]
+    truth: TrueTrajectory
 
-    def at(self, t: float) -> np.ndarray:
-        return np.array([np.interp(t, self.t, self.xy[:, 0]), np.interp(t, self.t, self.xy[:, 1])])
+    @classmethod
+    def of(cls, report: Mapping[str, Any]) -> Run:
+        return cls(report, TrueTrajectory(report["ground_truth"]))
 
 
-def goal_tolerance(teach: Mapping[str, Any], robot_radius: float, given: float | None) -> float:
+def goal_tolerance(teach: Run, robot_radius: float, given: float | None) -> float:
     """``given``, or the robot's diameter or the taught viewframes' mean spacing, whichever is larger."""
     if given is not None:
         return given
-    then = Trajectory(teach)
-    places = np.array([then.at(float(e["time_s"])) for e in teach.get("ltmap", {}).get("taught", [])])
+    taught = teach.report.get("ltmap", {}).get("taught", [])
+    places = np.array([teach.truth.position(float(e["time_s"])) for e in taught])
     spacing = float(np.hypot(*np.diff(places, axis=0).T).mean()) if len(places) > 1 else 0.0
     return max(2.0 * robot_radius, spacing)
 
 
-def viewframe_errors(teach: Mapping[str, Any], repeat: Mapping[str, Any]) -> list[float]:
+def viewframe_errors(teach: Run, repeat: Run) -> list[float]:
     """Per viewframe the repeat reached, the distance from where it was taught (module docstring)."""
-    taught = {int(e["viewframe"]): float(e["time_s"]) for e in teach["ltmap"].get("taught", [])}
-    section = repeat.get("ltmap", {})
+    taught = {int(e["viewframe"]): float(e["time_s"]) for e in teach.report["ltmap"].get("taught", [])}
+    section = repeat.report.get("ltmap", {})
     source = section.get("viewframe_source") or list(range(int(section.get("viewframes", 0))))
-    then, now = Trajectory(teach), Trajectory(repeat)
     out = []
     for entry in section.get("reached", []):
         v = int(entry["viewframe"])
         if 0 <= v < len(source) and int(source[v]) in taught:
-            out.append(float(np.hypot(*(now.at(float(entry["time_s"])) - then.at(taught[int(source[v])])))))
+            now, then = repeat.truth.position(float(entry["time_s"])), teach.truth.position(taught[int(source[v])])
+            out.append(float(np.hypot(*(now - then))))
     return out
 
 
-def repeat_figures(teach: Mapping[str, Any], repeat: Mapping[str, Any] | None, level: Level,
+def repeat_figures(teach: Run, repeat: Mapping[str, Any] | None, level: Level,
                    tolerance: float) -> dict[str, Any]:
     """The figures of one repeat (module docstring); a repeat without a report reached nothing."""
     out: dict[str, Any] = {"cut": level.cut, "height": level.height, "viewframes": level.viewframes,
                            "landmarks": level.landmarks, "bytes": level.bytes, "memory_fraction": level.fraction}
     if repeat is None or "ground_truth" not in repeat:
         return {**out, "status": "ERROR", "reached": False}
+    run = Run.of(repeat)
     section = repeat.get("ltmap", {})
-    errors = viewframe_errors(teach, repeat)
-    then, now = Trajectory(teach), Trajectory(repeat)
-    goal_error = float(np.hypot(*(now.xy[-1] - then.xy[0])))
+    errors = viewframe_errors(teach, run)
+    then, now = teach.truth.xy, run.truth.xy
+    goal_error = float(np.hypot(*(now[-1] - then[0])))
     reached = {int(e["viewframe"]) for e in section.get("reached", [])}
     out.update({
         "status": repeat["status"],
         "reason": repeat.get("reason", ""),
         "viewframe_error_m": float(np.mean(errors)) if errors else None,
-        "path_error_m": float(path_distances(now.xy, then.xy).mean()) if len(then.xy) > 1 else None,
+        "path_error_m": float(path_distances(now, then).mean()) if len(then) > 1 else None,
         "goal_error_m": goal_error,
         "reached": bool(repeat["status"] == "SUCCESS" and goal_error <= tolerance),
         "viewframes_reached": len(reached) / max(level.viewframes, 1),
@@ -328,7 +331,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     world, settings = options.checked or (check_world(options.world), check_options(options.world, options.extra))
     folder = Path(options.results_dir).resolve()
     teaches = _teach_phase(options, settings, folder, resume)
-    plan: list[tuple[Episode, dict[str, Any], Level]] = []
+    plan: list[tuple[Episode, Run, Level]] = []
     failed, teach_rows = [], []
     tolerance: dict[int, float] = {}
     for seed, (teach, report) in sorted(teaches.items()):
@@ -336,21 +339,22 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         if isinstance(tree, str) or report is None:
             failed.append({"seed": seed, "problem": str(tree)})
             continue
+        taught = Run.of(report)  # read once for all the repeats of this map
         minimum = min_landmarks_for(tree, settings.min_landmarks)
-        tolerance[seed] = goal_tolerance(report, world.robot_radius, settings.goal_tolerance)
+        tolerance[seed] = goal_tolerance(taught, world.robot_radius, settings.goal_tolerance)
         teach_rows.append({"seed": seed, "viewframes": tree.viewframe_count, "landmarks": tree.landmark_count,
                            "height": tree.height, "bytes": tree.memory_bytes(), "min_landmarks": minimum,
                            "goal_tolerance_m": tolerance[seed],
                            "path_length_m": report["ground_truth"]["trajectory_length_m"],
                            "sim_time_s": report.get("sim_time_s")})
-        plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation), report, level)
+        plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation), taught, level)
                  for level in levels(tree, minimum)]
     if plan:  # every repeat at once: the pool runs them in parallel
         run_sweep([episode for episode, _, _ in plan], executor=options.executor, results_dir=folder,
                   timeout_s=options.timeout_s, progress=options.progress, resume=True)
     runs = []
-    for episode, teach_report, level in plan:
-        figures = repeat_figures(teach_report, read_report(folder, episode.id), level, tolerance[episode.seed])
+    for episode, taught, level in plan:
+        figures = repeat_figures(taught, read_report(folder, episode.id), level, tolerance[episode.seed])
         runs.append({"seed": episode.seed, **figures})
     return summarise(world, settings, len(options.seeds), teach_rows, failed, runs)
 

@@ -42,6 +42,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from drivers.sim.floor import FloorGrid, reachable_floor
+from drivers.sim.simulation import start_to_world, world_to_start
 from drivers.sim.world import World
 from maps.planning import plan_path, segment_is_free
 from maps.room import FreeGrid
@@ -71,20 +72,6 @@ class Route:
     @property
     def length_m(self) -> float:
         return float(np.sum(np.hypot(*np.diff(self.world_xy, axis=0).T)))
-
-
-def to_world(start: Pose2D, xy: np.ndarray) -> np.ndarray:
-    """Odometry-frame points (N x 2, origin at the start pose) in the world frame."""
-    c, s = math.cos(start.theta), math.sin(start.theta)
-    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-    return np.column_stack((start.x + c * xy[:, 0] - s * xy[:, 1], start.y + s * xy[:, 0] + c * xy[:, 1]))
-
-
-def to_odometry(start: Pose2D, xy: np.ndarray) -> np.ndarray:
-    """World points (N x 2) in the odometry frame of the start pose."""
-    c, s = math.cos(start.theta), math.sin(start.theta)
-    rel = np.asarray(xy, dtype=np.float64).reshape(-1, 2) - (start.x, start.y)
-    return np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
 
 
 def parse_route(text: str) -> list[float]:
@@ -150,13 +137,6 @@ class Floor:
         g = self.grid
         return FreeGrid(g.free.T, g.resolution, (g.x0 + g.resolution / 2, g.y0 + g.resolution / 2))
 
-    def on_floor(self, xy: np.ndarray) -> np.ndarray:
-        """Whether each world point (N x 2) is on the reachable floor."""
-        rows, cols, inside = self.grid.cells_of(xy)
-        ok = np.zeros(len(rows), dtype=bool)
-        ok[inside] = self.grid.reachable[rows[inside], cols[inside]]
-        return ok
-
 
 def _window(centre: Pose2D, half: float) -> tuple[float, float, float, float]:
     return centre.x - half, centre.y - half, centre.x + half, centre.y + half
@@ -174,7 +154,7 @@ def default_route(world: World) -> Route:
     for margin in MARGINS:
         points = _tour(floor, from_start, start, margin, world.robot_radius)
         if points is not None:
-            return Route(points, to_odometry(start, points[1:]).ravel().tolist(), "tour", margin)
+            return Route(points, world_to_start(start, points[1:]).ravel().tolist(), "tour", margin)
     raise ValueError(f"no room for a route: the floor the robot reaches from the start ({start.x:g}, {start.y:g}) "
                      f"goes less than {MIN_END:g} m with {MARGINS[-1]:g} m of clearance; give waypoints with "
                      "--option route=x0,y0,...")
@@ -245,17 +225,17 @@ def given_route(world: World, odometry: Sequence[float]) -> Route:
     """Waypoints in the start's odometry frame, checked on the floor; ``ValueError`` naming the
     first waypoint or leg off the reachable floor."""
     start = world.start
-    points = np.vstack(([[start.x, start.y]], to_world(start, np.asarray(odometry, dtype=np.float64))))
+    points = np.vstack(([[start.x, start.y]], start_to_world(start, np.asarray(odometry, dtype=np.float64))))
     lo, hi = points.min(axis=0) - ROUTE_WINDOW_MARGIN, points.max(axis=0) + ROUTE_WINDOW_MARGIN
     floor = Floor.around(world, (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])))
     for k, (a, b) in enumerate(zip(points[:-1], points[1:], strict=True)):
         steps = max(1, math.ceil(float(np.hypot(*(b - a))) / (RESOLUTION / 2)))
         along = a + np.linspace(0.0, 1.0, steps + 1)[:, None] * (b - a)
-        if not floor.on_floor(along[-1:])[0]:
+        if not floor.grid.reachable_at(along[-1:])[0]:
             x, y = odometry[2 * k], odometry[2 * k + 1]
             raise ValueError(f"route: waypoint {k} ({x:g}, {y:g}) is not on the floor the robot reaches from the "
                              f"start (world ({b[0]:.2f}, {b[1]:.2f}))")
-        if not floor.on_floor(along).all():
+        if not floor.grid.reachable_at(along).all():
             raise ValueError(f"route: the leg to waypoint {k} passes closer than the robot's radius to a wall, box "
                              "or pillar")
     return Route(points, [float(v) for v in odometry], "given", None)

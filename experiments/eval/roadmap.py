@@ -30,7 +30,7 @@ Figures (simulator ground truth, evaluation only):
   they are, ``targets.poses`` (per seed, ``[x m, y m, theta deg]`` in the world frame);
 - per target found: its estimated pose (the report's ``roadmap.targets``, reference frame) against
   its true pose expressed in the TRUE reference frame, the robot's true pose at the report's
-  ``roadmap.room.reference_stamp`` (:class:`~experiments.eval.roadmap_world.TrueTrajectory`: exact,
+  ``roadmap.room.reference_stamp`` (:class:`~experiments.eval.trajectory.TrueTrajectory`: exact,
   the robot stands still when it takes an image); position (m) and heading (deg) errors; within
   the issue's thresholds when <= 0.15 m and <= 5 deg;
 - per learn: targets found, whether the graph is connected, its edges, sim and wall time;
@@ -57,7 +57,6 @@ from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
 from experiments.eval.figures import cell, mean_present
 from experiments.eval.roadmap_world import (
-    TrueTrajectory,
     place_targets,
     pose_error,
     random_starts,
@@ -68,6 +67,7 @@ from experiments.eval.roadmap_world import (
     world_with,
     write_target_images,
 )
+from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.episode import SweepInputError, absolute_if_file
 from experiments.sweep.table import read_report

@@ -36,9 +36,7 @@ target. So, without knowing the world:
   Open places taken first pack worse: a world too crowded for N targets so (12 in the lab) is
   placed again first come, first served.
 
-Everything is drawn from the seed alone. :class:`TrueTrajectory` reads where the robot truly
-was at a time from a report's ``ground_truth`` section (exact while it stood still, from the
-section's ``stops``; interpolated between the decimated trajectory's rows otherwise).
+Everything is drawn from the seed alone.
 """
 
 from __future__ import annotations
@@ -137,32 +135,6 @@ def target_errors(report: Mapping[str, Any], truth: Mapping[str, Pose2D], refere
     return errors
 
 
-class TrueTrajectory:
-    """Where the robot truly was at any time of a run, from its report's ``ground_truth`` section.
-
-    Within a stop (``ground_truth.stops``: the robot stood still) the pose is exact; elsewhere it is
-    interpolated between the decimated ``trajectory`` rows (t, x, y, theta), the heading along the
-    shorter way round. Before the first row or after the last, the first or last pose."""
-
-    def __init__(self, ground_truth: Mapping[str, Any]) -> None:
-        rows = np.asarray(ground_truth["trajectory"], dtype=np.float64).reshape(-1, 4)
-        if not len(rows):
-            raise ValueError("the ground truth has an empty trajectory")
-        self.t, self.x, self.y = rows[:, 0], rows[:, 1], rows[:, 2]
-        self.theta = np.unwrap(rows[:, 3])
-        self.stops = np.asarray(ground_truth.get("stops", []), dtype=np.float64).reshape(-1, 5)
-
-    def at(self, t: float) -> Pose2D:
-        """The true pose at time ``t`` (s of simulated time)."""
-        within = np.flatnonzero((self.stops[:, 0] <= t) & (t <= self.stops[:, 1]))
-        if len(within):
-            _, _, x, y, theta = self.stops[within[0]]
-            return Pose2D(float(x), float(y), float(theta), stamp=t)
-        theta = float(np.interp(t, self.t, self.theta))
-        return Pose2D(float(np.interp(t, self.t, self.x)), float(np.interp(t, self.t, self.y)), wrap_angle(theta),
-                      stamp=t)
-
-
 def reachable_grid(world: World) -> FloorGrid:
     """Where the robot's centre can go from the world's start (``ValueError`` if the start is not free)."""
     return reachable_floor(world, resolution=0.05)
@@ -174,9 +146,8 @@ def usable_poses(world: World, grid: FloorGrid | None = None) -> dict[str, Pose2
     names = sorted(world.poses)
     if not names:
         return {}
-    rows, cols, inside = grid.cells_of(np.array([[world.poses[n].x, world.poses[n].y] for n in names]))
-    return {n: world.poses[n] for n, r, c, ok in zip(names, rows, cols, inside, strict=True)
-            if ok and grid.reachable[r, c]}
+    on_floor = grid.reachable_at(np.array([[world.poses[n].x, world.poses[n].y] for n in names]))
+    return {n: world.poses[n] for n, ok in zip(names, on_floor, strict=True) if ok}
 
 
 @dataclass(frozen=True)
@@ -201,8 +172,7 @@ class FreeFloor:
 
     def is_free(self, x: float, y: float) -> bool:
         """Whether (x, y) is reachable and clear enough."""
-        row, col, inside = self.grid.cells_of(np.array([x, y]))
-        return bool(inside[0] and self.grid.reachable[row[0], col[0]]) and self.scene.clearance(x, y) >= self.clearance
+        return bool(self.grid.reachable_at(np.array([x, y]))[0]) and self.scene.clearance(x, y) >= self.clearance
 
     def draw(self, rng: np.random.Generator, judge: Callable[[float, float], T | None],
              draws: int = MAX_DRAWS) -> T | None:

@@ -11,10 +11,12 @@ import math
 import numpy as np
 import pytest
 
+from drivers.sim.simulation import start_to_world
 from drivers.sim.world import load_world
 from experiments.eval import AREAS
 from experiments.eval.ltmap import (
     Level,
+    Run,
     check_options,
     follow_episode,
     format_table,
@@ -22,7 +24,7 @@ from experiments.eval.ltmap import (
     repeat_figures,
     viewframe_errors,
 )
-from experiments.eval.ltmap_route import MARGINS, MIN_END, Floor, default_route, parse_route, to_world
+from experiments.eval.ltmap_route import MARGINS, MIN_END, Floor, default_route, parse_route
 from experiments.sweep import Episode
 from missions.cli import main
 
@@ -53,11 +55,12 @@ def test_the_default_route_is_a_bent_tour_of_the_free_floor(world_file):
     start = world.start
     assert route.source == "tour" and route.margin_m in MARGINS
     assert route.world_xy[0].tolist() == [start.x, start.y]
-    np.testing.assert_allclose(to_world(start, np.reshape(route.odometry, (-1, 2))), route.world_xy[1:], atol=1e-9)
+    odometry = np.reshape(route.odometry, (-1, 2))
+    np.testing.assert_allclose(start_to_world(start, odometry), route.world_xy[1:], atol=1e-9)
     floor = Floor.around(world, (-1.0, -1.0, 7.0, 5.0))
     legs = zip(route.world_xy[:-1], route.world_xy[1:], strict=True)
     along = np.concatenate([np.linspace(a, b, 50) for a, b in legs])
-    assert floor.on_floor(along).all()  # never closer than the robot's radius to a wall, box or pillar
+    assert floor.grid.reachable_at(along).all()  # never closer than the robot's radius to a wall, box or pillar
     assert math.dist(route.world_xy[0], route.world_xy[-1]) >= MIN_END and route.length_m > 3.0
     assert len(route.world_xy) >= 3  # it turns: not a straight line
 
@@ -115,17 +118,18 @@ def test_viewframes_are_matched_through_times_and_sources():
     repeat = _report([[t, 2.0 - t, 0.1, math.pi] for t in range(3)],
                      ltmap={"viewframes": 2, "viewframe_source": [0, 2],
                             "reached": [{"viewframe": 1, "time_s": 0.0}, {"viewframe": 0, "time_s": 1.5}]})
-    assert viewframe_errors(teach, repeat) == pytest.approx([0.1, math.hypot(0.5, 0.1)])
-    assert goal_tolerance(teach, robot_radius=0.26, given=None) == pytest.approx(1.0)  # the viewframes' spacing
-    assert goal_tolerance(teach, robot_radius=0.6, given=None) == pytest.approx(1.2)  # the robot's diameter
-    assert goal_tolerance(teach, robot_radius=0.26, given=0.3) == 0.3
+    taught = Run.of(teach)
+    assert viewframe_errors(taught, Run.of(repeat)) == pytest.approx([0.1, math.hypot(0.5, 0.1)])
+    assert goal_tolerance(taught, robot_radius=0.26, given=None) == pytest.approx(1.0)  # the viewframes' spacing
+    assert goal_tolerance(taught, robot_radius=0.6, given=None) == pytest.approx(1.2)  # the robot's diameter
+    assert goal_tolerance(taught, robot_radius=0.26, given=0.3) == 0.3
     level = Level(cut=1, height=1, viewframes=2, landmarks=40, bytes=900, fraction=0.5)
-    figures = repeat_figures(teach, repeat, level, tolerance=0.5)
+    figures = repeat_figures(taught, repeat, level, tolerance=0.5)
     assert figures["path_error_m"] == pytest.approx(0.1) and figures["goal_error_m"] == pytest.approx(0.1)
     assert figures["reached"] and figures["viewframes_reached"] == 1.0
-    assert not repeat_figures(teach, repeat, level, tolerance=0.05)["reached"]
-    assert not repeat_figures(teach, {**repeat, "status": "FAILURE"}, level, tolerance=0.5)["reached"]
-    assert repeat_figures(teach, None, level, tolerance=0.5) | {"reached": False} == {
+    assert not repeat_figures(taught, repeat, level, tolerance=0.05)["reached"]
+    assert not repeat_figures(taught, {**repeat, "status": "FAILURE"}, level, tolerance=0.5)["reached"]
+    assert repeat_figures(taught, None, level, tolerance=0.5) | {"reached": False} == {
         "cut": 1, "height": 1, "viewframes": 2, "landmarks": 40, "bytes": 900, "memory_fraction": 0.5,
         "status": "ERROR", "reached": False}
 

@@ -32,7 +32,6 @@ from experiments.eval.roadmap_world import (
     START_CLEARANCE,
     TARGET_CLEARANCE,
     FreeFloor,
-    TrueTrajectory,
     best_heading,
     camera_rays,
     camera_view,
@@ -210,21 +209,6 @@ def test_placed_targets_go_into_a_copy_of_the_world(world_file, tmp_path):
         assert math.degrees(copy.poses[name].theta) == pytest.approx(math.degrees(pose.theta))
     named = str(world_file(FURNISHED, "furnished.yaml"))
     assert seed_targets(named, load_world(named), check_options(named, {}), 2, tmp_path / "eval").world == named
-
-
-def test_the_true_pose_at_a_time_is_exact_in_a_stop_and_interpolated_elsewhere():
-    # still at (1, 2, 170 deg) from t = 4.0 to 4.3, then turning fast; decimated rows 0.5 s apart
-    truth = {"trajectory": [[3.5, 0.9, 2.0, math.radians(170)], [4.0, 1.0, 2.0, math.radians(170)],
-                            [4.5, 1.0, 2.0, math.radians(-170)], [5.0, 1.2, 2.0, math.radians(-150)]],
-             "stops": [[4.0, 4.3, 1.0, 2.0, math.radians(170)]]}
-    trajectory = TrueTrajectory(truth)
-    at = trajectory.at(4.3)
-    assert (at.x, at.y, at.theta) == pytest.approx((1.0, 2.0, math.radians(170)))
-    moving = trajectory.at(4.75)  # interpolated, the heading the short way round through 180 deg
-    assert (moving.x, math.degrees(moving.theta)) == pytest.approx((1.1, -160.0))
-    without = TrueTrajectory({"trajectory": truth["trajectory"]}).at(4.25)  # an old report: no stops
-    assert abs(math.degrees(without.theta)) == pytest.approx(180.0)
-    assert TrueTrajectory(truth).at(99.0).x == pytest.approx(1.2)  # after the last row: the last pose
 
 
 def _learn_report(reference: Pose2D, estimates: dict[str, Pose2D], **section) -> dict:

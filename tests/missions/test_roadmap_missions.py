@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from experiments.eval.roadmap_world import TrueTrajectory, named_poses, pose_error, world_with, write_target_images
+from experiments.eval.roadmap_world import named_poses, pose_error, world_with, write_target_images
+from experiments.eval.trajectory import TrueTrajectory
 from maps.roadmap import EdgeMotion, Roadmap
 from missions.cli import main
 from perception.geometry import Pose2D
