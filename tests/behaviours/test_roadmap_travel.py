@@ -12,6 +12,7 @@ from behaviours.roadmap.paths import nearest_standable, reanchored
 from behaviours.roadmap.travel import GoToPose, ReturnToReference
 from behaviours.roadmap.values import TargetView
 from behaviours.roadmap.vision import describe
+from behaviours.telemetry import Lines, report_sections
 from behaviours.testing import BehaviourHarness
 from maps.room import RoomEstimate
 from perception.geometry import Pose2D
@@ -38,6 +39,10 @@ def test_goes_round_the_wall_to_a_pose_in_the_reference_frame():
     assert plan.ok and len(plan.waypoints) > 2  # not straight: the wall is in the way
     here = room.to_reference(harness.read("/robot/odometry"))
     assert here.distance_to(Pose2D(3.3, 2.5)) < 0.03 and here.theta == pytest.approx(-math.pi / 2, abs=0.02)
+    (path,) = harness.behaviour.drawings()  # the plan, drawn once
+    assert isinstance(path, Lines) and path.entity == "roadmap/plan"
+    assert path.strips[0].tolist() == [[w.x, w.y] for w in plan.waypoints]
+    assert list(harness.behaviour.drawings()) == []
 
 
 def test_no_path_fails_with_the_planners_reason():
@@ -83,5 +88,14 @@ def test_returns_to_the_reference_homes_there_and_reanchors_the_room():
     anchored = harness.read("/map/room").reference_pose
     assert anchored.distance_to(truth_in_odometry) < 0.03
     assert abs(math.degrees(anchored.theta - truth_in_odometry.theta)) < 1.0
-    section = harness.behaviour.report_sections()["roadmap"]
-    assert section["reference_drift_m (ReturnToReference)"][0] == pytest.approx(math.hypot(0.15, 0.1), abs=0.04)
+    section = report_sections(harness.behaviour)["roadmap"]
+    assert list(section) == ["reference_drift_m (ReturnToReference)"]
+    (drift,) = section["reference_drift_m (ReturnToReference)"]
+    assert drift == pytest.approx(math.hypot(0.15, 0.1), abs=0.04) and drift == round(drift, 4)
+
+
+def test_no_return_no_figure_and_each_return_node_reports_under_its_own_name():
+    assert report_sections(ReturnToReference()) == {}
+    node = ReturnToReference(name="return at the end")
+    node.returns, node.corrections = 2, [0.123456, 0.05]
+    assert report_sections(node) == {"roadmap": {"reference_drift_m (return at the end)": [0.1235, 0.05]}}
