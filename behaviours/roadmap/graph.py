@@ -72,7 +72,7 @@ from behaviours.roadmap.paths import PLAN_PORTS, reanchored, travel
 from behaviours.roadmap.room import ROOM_IN
 from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.targets import TARGETS_IN, relative_images
-from behaviours.roadmap.travel import REFERENCE_IN
+from behaviours.roadmap.travel import REFERENCE_IN, return_to_reference
 from behaviours.roadmap.values import TargetImages, TargetView
 from behaviours.telemetry import Drawing, Figure
 from maps.planning import segment_is_free
@@ -265,15 +265,12 @@ class BuildGraph(RoutineBehaviour):
         self.set_output(self.ROOM_OUT, self.room)
 
     def _to_reference(self, settings: HomingSettings) -> Step[None]:
+        """After a failed pair: back to the reference (a travel that runs into something, once more)."""
         assert self.room is not None
         reference = self.get_input(REFERENCE_IN, None)
         if reference is None:
             raise Failed("an edge failed and there is no reference image to return to")
-        try:
-            yield from travel(self, self.room, Pose2D(), turn=True)
-        except Failed:  # ran into something on the way back (the map is off by the drift): once more
-            yield from travel(self, self.room, Pose2D(), turn=True)
-        result = yield from home(self, reference, settings)
+        result = yield from return_to_reference(self, self.room, reference, settings, retries=1)
         self._anchor(result.pose)
 
     def _finish(self) -> None:

@@ -21,12 +21,30 @@ from behaviours.roadmap.homing import REQUIRED_ROOM, HomingSettings, home
 from behaviours.roadmap.paths import PLAN_OUT, PLAN_PORTS, reanchored, travel
 from behaviours.roadmap.room import ROOM_IN
 from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
-from behaviours.roadmap.values import TargetView
+from behaviours.roadmap.values import HomingResult, TargetView
 from behaviours.telemetry import Drawing, Figure
 from maps.room import RoomEstimate
 from perception.geometry import Pose2D
 
 REFERENCE_IN = InputPort("reference", TargetView, Ref("/map/reference_image"), doc="the image taken at the reference")
+
+
+def return_to_reference(host: RoutineBehaviour, room: RoomEstimate, reference: TargetView,
+                        settings: HomingSettings, *, retries: int = 0) -> Step[HomingResult]:
+    """Travel to the reference pose (planned in ``room``) and home to the reference image there.
+
+    The homed pose (odometry frame) is where the reference truly is now: the caller re-anchors the
+    room there. A travel that fails (ran into something: the map is off by the drift) is tried
+    ``retries`` more times before its failure is the caller's.
+    """
+    for attempt in range(retries + 1):
+        try:
+            yield from travel(host, room, Pose2D(), turn=True)
+            break
+        except Failed:
+            if attempt == retries:
+                raise
+    return (yield from home(host, reference, settings))
 
 
 class PlanningRoutine(RoutineBehaviour):
@@ -81,8 +99,7 @@ class ReturnToReference(PlanningRoutine):
         reference = self.get_input(REFERENCE_IN, None)
         if room is None or reference is None:
             raise Failed("no room estimate" if room is None else "no reference image")
-        yield from travel(self, room, Pose2D(0.0, 0.0, 0.0), turn=True)
-        result = yield from home(self, reference, HomingSettings.of(self))
+        result = yield from return_to_reference(self, room, reference, HomingSettings.of(self))
         correction = result.pose.relative_to(room.reference_pose)
         self.set_output(self.ROOM_OUT, reanchored(room, result.pose))
         self.returns += 1

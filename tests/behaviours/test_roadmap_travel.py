@@ -8,8 +8,11 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
+from behaviours.roadmap import travel as travel_module
+from behaviours.roadmap.homing import HomingSettings
 from behaviours.roadmap.paths import nearest_standable, reanchored
-from behaviours.roadmap.travel import GoToPose, ReturnToReference
+from behaviours.roadmap.routine import Failed
+from behaviours.roadmap.travel import GoToPose, ReturnToReference, return_to_reference
 from behaviours.roadmap.values import TargetView
 from behaviours.roadmap.vision import describe
 from behaviours.telemetry import Lines, report_sections
@@ -99,3 +102,40 @@ def test_no_return_no_figure_and_each_return_node_reports_under_its_own_name():
     node = ReturnToReference(name="return at the end")
     node.returns, node.corrections = 2, [0.123456, 0.05]
     assert report_sections(node) == {"roadmap": {"reference_drift_m (return at the end)": [0.1235, 0.05]}}
+
+
+def finish(step):
+    """Run a routine step to its end, as ticks would: its result."""
+    try:
+        while True:
+            next(step)
+    except StopIteration as stop:
+        return stop.value
+
+
+@pytest.mark.parametrize(("retries", "travels"), [(0, 1), (1, 2)])
+def test_returning_to_the_reference_travels_again_only_as_often_as_told(monkeypatch, retries, travels):
+    calls: list[Pose2D] = []
+
+    def travel(host, room, goal, *, turn):
+        calls.append(goal)
+        assert turn
+        if len(calls) == 1:
+            raise Failed("stalled")
+        yield
+
+    def home(host, reference, settings):
+        yield
+        return ("homed", reference.name, settings)
+
+    monkeypatch.setattr(travel_module, "travel", travel)
+    monkeypatch.setattr(travel_module, "home", home)
+    settings = HomingSettings(0.25, 0.08, 5, 25)
+    reference = TargetView("reference", np.zeros((4, 4), np.uint8), describe(np.zeros((4, 4), np.uint8)))
+    step = return_to_reference(None, u_room(Pose2D()), reference, settings, retries=retries)
+    if retries == 0:
+        with pytest.raises(Failed, match="stalled"):
+            finish(step)
+    else:
+        assert finish(step) == ("homed", "reference", settings)
+    assert calls == [Pose2D()] * travels  # always to the reference pose, the origin of the reference frame
