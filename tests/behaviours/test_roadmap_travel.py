@@ -10,7 +10,6 @@ from py_trees.common import Status
 
 from behaviours.roadmap import travel as travel_module
 from behaviours.roadmap.homing import HomingSettings
-from behaviours.roadmap.paths import nearest_standable, reanchored
 from behaviours.roadmap.routine import Failed
 from behaviours.roadmap.travel import GoToPose, ReturnToReference, return_to_reference
 from behaviours.roadmap.values import TargetView
@@ -55,22 +54,6 @@ def test_no_path_fails_with_the_planners_reason():
                                            "/mission/goal": Pose2D(8.0, 8.0)})
     assert harness.tick_until(between=integrate) == Status.FAILURE
     assert "no path: the goal is more than" in harness.behaviour.feedback_message
-
-
-def test_nearest_standable_snaps_within_reach_only():
-    free = u_room(Pose2D()).free
-    assert nearest_standable(free, 0.7, 2.5, 0.28) == (0.7, 2.5)
-    snapped = nearest_standable(free, 0.05, 2.5, 0.28)
-    assert snapped is not None and free.can_stand(np.array([snapped]), 0.28)[0]
-    assert nearest_standable(free, 2.0, 2.5, 0.28, snap=0.2) is None  # inside the wall, too far from floor
-
-
-def test_reanchoring_moves_the_reference_only():
-    room = u_room(Pose2D())
-    free = room.free
-    moved = reanchored(room, Pose2D(0.3, 0.1, 0.2))
-    assert moved.free is free and moved.reference_pose == Pose2D(0.3, 0.1, 0.2)
-    assert np.array_equal(moved.polygon, room.polygon)
 
 
 def test_returns_to_the_reference_homes_there_and_reanchors_the_room():
