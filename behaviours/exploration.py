@@ -1,6 +1,6 @@
 """Exploration with the stereo pair on the pan-tilt unit (algorithm 3): the map and the next goal.
 
-- :class:`MapStereo` integrates dense stereo into the exploration map (:mod:`maps.exploration`)
+- :class:`MapStereo` integrates dense stereo into the exploration map (:mod:`maps.exploration.integrate`)
   and marks the floor under the robot, every tick; it never ends (RUNNING).
 - :class:`SelectGoalPoint` chooses where to go next by the attractive power of the detected points
   (eq. 1; frontier mode when no point lies more than K beyond the border), and succeeds when no
@@ -14,7 +14,6 @@ the gaze :mod:`behaviours.gaze`.
 
 from __future__ import annotations
 
-import base64
 import math
 from typing import Any
 
@@ -26,17 +25,11 @@ from behaviours.base import BearingsBehaviour
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from drivers.interfaces import PanTiltState
-from maps.exploration import (
-    Cell,
-    ExplorationMap,
-    IntegrationParams,
-    StereoHead,
-    borders,
-    integrate_stereo,
-    mark_traversed,
-    observation_scan,
-)
-from maps.exploration_goal import Goal, GoalParams, Mode, ModeSwitch, select_goal, verification_goal
+from maps.exploration.codec import pack_cells
+from maps.exploration.goal import Goal, GoalParams, Mode, ModeSwitch, select_goal, verification_goal
+from maps.exploration.grid import Cell, ExplorationMap, borders, mark_traversed
+from maps.exploration.head import StereoHead
+from maps.exploration.integrate import IntegrationParams, integrate_observation, observe
 from perception.camera import PinholeCamera, StereoRig
 from perception.frame import Frame
 from perception.geometry import Pose2D
@@ -98,17 +91,6 @@ def halved(rig: StereoRig) -> StereoRig:
                              (c.cx + 0.5) / 2.0 - 0.5, (c.cy + 0.5) / 2.0 - 0.5, c.dist)
 
     return StereoRig(half(rig.left), half(rig.right), rig.baseline)
-
-
-def pack_cells(mask: np.ndarray) -> str:
-    """A boolean grid as base64 of its packed bits (row-major), for reports."""
-    return base64.b64encode(np.packbits(mask.astype(bool).ravel()).tobytes()).decode("ascii")
-
-
-def unpack_cells(text: str, rows: int, cols: int) -> np.ndarray:
-    """The inverse of :func:`pack_cells`."""
-    bits = np.unpackbits(np.frombuffer(base64.b64decode(text), dtype=np.uint8))
-    return bits[: rows * cols].reshape(rows, cols).astype(bool)
 
 
 @register
@@ -221,11 +203,11 @@ class MapStereo(BearingsBehaviour):
         view = self.head.view(pose, ptu.pan, ptu.tilt)
         above = points @ view.rotation[2] + view.eye[2] >= -BELOW_FLOOR  # the floor is flat: lower is a wrong match
         points, uv = points[above], uv[above]
-        self.map = integrate_stereo(self.map, points, uv, view, self._params)
-        _, ranges = observation_scan(points, view, self._params)
-        self._scan_bins = len(ranges)
+        seen = observe(points, uv, view, self._params)  # its range scan: integrated and recorded
+        self.map = integrate_observation(self.map, seen, self._params)
+        self._scan_bins = len(seen.ranges)
         self.scans.append([round(self.now(), 2), round(ptu.pan, 4), round(ptu.tilt, 4),
-                           *np.round(ranges, 2).tolist()])
+                           *np.round(seen.ranges, 2).tolist()])
 
     def report_sections(self) -> dict[str, dict[str, Any]]:
         """The ``exploration`` section's map part (see the class docstring)."""
@@ -269,7 +251,7 @@ class SelectGoalPoint(BearingsBehaviour):
 
     ``A_P = d(P_p, P_b) - eta G(v_S, P_b)``: the detected point farthest beyond the explored
     border, less eta times the travel cost to that border; the goal is the border point ``P_b``
-    (see :mod:`maps.exploration_goal`). No point more than ``k`` beyond the border: frontier mode,
+    (see :mod:`maps.exploration.goal`). No point more than ``k`` beyond the border: frontier mode,
     the closest reachable border point, until one is (``strategy: closest_frontier``: frontier
     mode always, the evaluation's baseline). The goal is chosen again every ``reselect`` seconds
     (the map grows as the robot drives; the current goal is kept while within ``hysteresis`` of the
@@ -286,7 +268,7 @@ class SelectGoalPoint(BearingsBehaviour):
     changed since: a doorway's stray obstacles cleared; the cameras looked elsewhere on arrival);
     one reached or abandoned again is avoided for good. Before a selection without a reachable border
     counts, the obstacle cells that close a border a narrower disc reaches are looked at again
-    (:func:`maps.exploration_goal.verification_goal`: a VERIFY goal), once per place.
+    (:func:`maps.exploration.goal.verification_goal`: a VERIFY goal), once per place.
     The mode, strikes, spent points, avoided targets and verified places outlive re-entries.
     """
 
@@ -402,7 +384,7 @@ class SelectGoalPoint(BearingsBehaviour):
 
     def _verify(self, m: ExplorationMap, pose: Pose2D) -> bool:
         """No border is reachable: set a VERIFY goal if some border is closed only by cells worth
-        looking at again (:func:`maps.exploration_goal.verification_goal`)."""
+        looking at again (:func:`maps.exploration.goal.verification_goal`)."""
         goal = verification_goal(m, (pose.x, pose.y), self.params, avoid=self._avoided(),
                                  verified=np.array(self.verified) if self.verified else None)
         if goal is None:

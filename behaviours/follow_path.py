@@ -60,8 +60,9 @@ from behaviours.motion import ANGULAR_DECEL, COMMAND, LINEAR_DECEL, STALLED, ram
 from behaviours.ports import InputPort, OutputPort
 from behaviours.registry import register
 from drivers.interfaces import STOP, VelocityCommand
-from maps.exploration import Cell, ExplorationMap, travel_cost
-from maps.exploration_goal import Goal
+from maps.exploration.goal import Goal
+from maps.exploration.grid import Cell, ExplorationMap
+from maps.exploration.travel import travel_cost
 from perception.geometry import Pose2D, wrap_angle
 
 

@@ -28,8 +28,10 @@ from behaviours.exploration import CAMERA_POSITION, MAP, POSE, PTU_POSITION, xyz
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from drivers.interfaces import PanTiltCommand, PanTiltState
-from maps.exploration import Cell, ExplorationMap, Interest, StereoHead
-from maps.exploration_gaze import Gaze, GazeParams, next_gaze, pan_to_point, survey
+from maps.exploration.gaze import Gaze, GazeParams, next_gaze, pan_to_point, survey
+from maps.exploration.grid import Cell, ExplorationMap
+from maps.exploration.head import StereoHead
+from maps.exploration.interest import Interest
 from perception.geometry import Pose2D
 
 # The simulator's default stereo pair: 640 x 480, f = 525 px.

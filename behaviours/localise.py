@@ -19,7 +19,7 @@ from py_trees.common import Status
 from behaviours.base import BearingsBehaviour
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
-from maps.exploration_pose import FilterParams, PoseFilter
+from maps.exploration.pose import FilterParams, PoseFilter
 from perception.frame import LandmarkBearings
 from perception.geometry import Pose2D
 

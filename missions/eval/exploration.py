@@ -37,10 +37,12 @@ from typing import Any
 import cv2
 import numpy as np
 
-from behaviours.exploration import unpack_cells
 from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.world import load_world
-from maps.exploration import GridFrame, StereoHead, scan_cells
+from maps.exploration.codec import unpack_cells
+from maps.exploration.grid import GridFrame
+from maps.exploration.head import StereoHead
+from maps.exploration.integrate import scan_cells
 from missions.eval import EvalOptions
 from missions.sweep import Episode, run_sweep
 from missions.sweep.table import read_report

@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.exploration import MapStereo, SelectGoalPoint, drop_jumps, pack_cells, unpack_cells
+from behaviours.exploration import MapStereo, SelectGoalPoint, drop_jumps
 from behaviours.testing import BehaviourHarness
 from drivers.sim.simulation import Simulation
-from maps.exploration import Cell, ExplorationMap, GridFrame
-from maps.exploration_goal import Mode
+from maps.exploration.codec import pack_cells, unpack_cells
+from maps.exploration.goal import Mode
+from maps.exploration.grid import Cell, ExplorationMap, GridFrame
 from perception.geometry import Pose2D
 
 MAP, GOAL, POSE = "/map/exploration", "/map/exploration_goal", "/robot/pose"

@@ -11,8 +11,8 @@ from py_trees.common import Status
 from behaviours.follow_path import FollowPath
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP
-from maps.exploration import Cell, ExplorationMap, GridFrame
-from maps.exploration_goal import Goal, Mode
+from maps.exploration.goal import Goal, Mode
+from maps.exploration.grid import Cell, ExplorationMap, GridFrame
 from perception.geometry import Pose2D
 
 FRAME = GridFrame(-1.0, -1.0, 0.05, 40, 100)  # x -1..4, y -1..1

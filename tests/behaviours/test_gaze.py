@@ -13,9 +13,11 @@ from behaviours.follow_path import FollowPath
 from behaviours.gaze import LookAround, WatchInterestEdges
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import PanTiltState
-from maps.exploration import Cell, ExplorationMap, GridFrame, Interest, StereoHead
-from maps.exploration_gaze import GazeParams, camera_lift, speed_limit, survey
-from maps.exploration_goal import Goal, Mode
+from maps.exploration.gaze import GazeParams, camera_lift, speed_limit, survey
+from maps.exploration.goal import Goal, Mode
+from maps.exploration.grid import Cell, ExplorationMap, GridFrame
+from maps.exploration.head import StereoHead
+from maps.exploration.interest import Interest
 from perception.geometry import Pose2D
 
 HEAD = StereoHead()  # the defaults of the ports: the simulator's stereo pair on the PTU-D46

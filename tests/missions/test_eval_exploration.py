@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from behaviours.exploration import pack_cells
 from drivers.sim.world import load_world
-from maps.exploration import StereoHead, footprint
+from maps.exploration.codec import pack_cells
+from maps.exploration.head import StereoHead, footprint
 from missions.cli import main
 from missions.eval.exploration import check_world, episode_figures, episodes, seen_floor, summarise_variant
 from perception.geometry import Pose2D
