@@ -129,6 +129,11 @@ def test_viewframes_are_matched_through_times_and_sources():
     assert figures["reached"] and figures["viewframes_reached"] == 1.0
     assert not repeat_figures(taught, repeat, level, tolerance=0.05)["reached"]
     assert not repeat_figures(taught, {**repeat, "status": "FAILURE"}, level, tolerance=0.5)["reached"]
+    touched = {**repeat, "ground_truth": {**repeat["ground_truth"], "collisions": 1, "min_clearance_m": 0.0},
+               "safety": {"safety_stops": 2}}  # home, but it touched something on the way: not reached
+    collided = repeat_figures(taught, touched, level, tolerance=0.5)
+    assert not collided["reached"] and (collided["collisions"], collided["safety_stops"]) == (1, 2)
+    assert (figures["collisions"], figures["safety_stops"], figures["min_clearance_m"]) == (0, 0, None)
     assert repeat_figures(taught, None, level, tolerance=0.5) | {"reached": False} == {
         "cut": 1, "height": 1, "viewframes": 2, "landmarks": 40, "bytes": 900, "memory_fraction": 0.5,
         "status": "ERROR", "reached": False}

@@ -20,6 +20,8 @@ from drivers.interfaces import Robot
 from drivers.pioneer_body import BODIES
 from drivers.safety.settings import monitor_config
 from drivers.sim.simulation import Simulation
+from missions.cli import main
+from missions.commands.run import outcome_lines
 from missions.loader import load_mission
 from missions.runner import Runner, RunOptions
 from perception.geometry import Pose2D
@@ -147,3 +149,16 @@ def test_the_tree_reads_the_monitors_state_and_the_recording_gets_an_event_line(
     assert [e.entity for e in events] == ["safety/events"]
     assert events[0].text.startswith("safety stopped (stop stop): obstacle 0.07 m from the footprint")
     assert [d.value for d in recorder.drawn if isinstance(d, Plot)] == [0.0, 1.0]
+
+
+def test_bearings_run_ends_with_the_collisions_the_stops_and_the_clearance(capsys):
+    assert main(["run", "square", "--quiet"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[1] == "safety: 0 stops, 0 slow-downs, 0 bumper hits, nearest sensed nothing (sensors: none)"
+    assert out[2].startswith("ground truth: collisions 0, trajectory_length_m ")
+    report = {"safety": {"safety_stops": 2, "slowdowns": 1, "bumper_hits": 0, "min_range_m": 0.081,
+                         "sources": "scene sonar (16 transducers)"},
+              "ground_truth": {"collisions": 0, "min_clearance_m": 0.0794, "trajectory_length_m": 1.2}}
+    assert outcome_lines(report) == [
+        "safety: 2 stops, 1 slow-downs, 0 bumper hits, nearest sensed 0.081 m (sensors: scene sonar (16 transducers))",
+        "ground truth: collisions 0, min_clearance_m 0.079, trajectory_length_m 1.200"]
