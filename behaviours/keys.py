@@ -11,7 +11,10 @@ the mission's nodes declare:
   tick, so nodes can read inputs at run time (``{/mission/speed}``) as well as at load time
   (``${speed}``);
 - the data-gathering branch writes the sensed keys (its nodes' output ports,
-  :data:`behaviours.sense.SENSE_NODES`).
+  :data:`behaviours.sense.SENSE_NODES`);
+- the runner *writes* the collision monitor's verdict on the command it sent at the end of the
+  previous tick (:data:`RUNNER_KEYS`: ``/robot/safety``, clear before the first), so a behaviour
+  can tell that the robot is being slowed or stopped, and why.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from drivers.interfaces import PanTiltCommand, VelocityCommand
+from perception.collision_monitor import SafetyState
 
 MISSION_NAMESPACE = "/mission"
 
@@ -37,6 +41,11 @@ COMMAND_KEYS = (
     KeySpec("/robot/command", VelocityCommand, "velocity for this tick; cleared before every tick"),
     KeySpec("/ptu/command", PanTiltCommand, "pan/tilt target; cleared before every tick"),
 )
+
+SAFETY_KEY = KeySpec("/robot/safety", SafetyState, "the collision monitor on the last command sent: clear, slowed "
+                     "or stopped, by which action and zone, and why")
+RUNNER_KEYS = (SAFETY_KEY,)
+"""Keys the runner writes every tick (besides the mission inputs)."""
 
 
 def input_key(name: str) -> str:

@@ -13,6 +13,7 @@ from typing import Protocol, runtime_checkable
 
 from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
+from perception.ranges import RangeScan
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,6 +111,17 @@ class KeySource(Protocol):
         """Give the input back (restore the terminal)."""
 
 
+@runtime_checkable
+class RangeSource(Protocol):
+    """Range sensors and bumpers around the base (a sonar ring, the simulator's model of one)."""
+
+    def read(self) -> RangeScan | None:
+        """The newest reading of every sensor and bumper, or None before the first."""
+
+    def close(self) -> None:
+        """Release the device."""
+
+
 KeyboardOpener = Callable[[], KeySource]
 """Opens the operator's keyboard when a node first needs it (OSError: there is none). The runner
 hands one to the tree at setup (``setup(keyboard=...)``), so nothing is opened unless a node that
@@ -123,6 +135,7 @@ class Robot:
     base: Base
     ptu: PanTilt | None = None
     cameras: dict[str, Camera] = field(default_factory=dict)
+    ranges: RangeSource | None = None
     name: str = "robot"
 
     def missing_cameras(self, names: Iterable[str]) -> list[str]:

@@ -22,7 +22,8 @@ and ``map_on_obstacles_m2`` is how much of that map's explored floor lies on wal
 
 Figures per variant (means over seeds unless named otherwise): final ``coverage``, its minimum,
 ``ok`` (episodes that ended by themselves with coverage >= 0.95 and no collision), ``done``,
-``collisions``, ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
+``collisions`` and ``safety_stops`` (summed over the runs), ``min_clearance_m`` (the smallest, when
+the simulator reports it), ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
 and after 60, 120 and 240 s, and the path length and time to reach 50, 80, 90 and 95 % (None when
 not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m to
 the two others'.
@@ -41,6 +42,7 @@ from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.simulation import start_to_world
 from drivers.sim.world import load_world
 from experiments.eval import EvalOptions
+from experiments.eval.figures import safety_figures, safety_totals
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.table import read_report
@@ -160,7 +162,7 @@ def episode_figures(report: dict[str, Any] | None, floor: FloorGrid, robot_radiu
         "coverage": coverage,
         "coverage_map": floor.coverage(placed) if len(placed) else 0.0,
         "map_on_obstacles_m2": on_obstacles * floor.resolution**2,
-        "collisions": int(truth.get("collisions", 0)),
+        **safety_figures(report),
         "path_length_m": float(truth["trajectory_length_m"]),
         "sim_time_s": float(report.get("sim_time_s", truth.get("sim_time_s", 0.0))),
         "odometry_drift_m": float(truth.get("odometry_drift_m", math.nan)),
@@ -225,7 +227,7 @@ def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
         values = [r.get(key) for r in good]
         if good and any(key in r for r in good):
             out[key] = _mean(values)
-    out["collisions"] = sum(int(r.get("collisions", 0)) for r in good)  # a count over the runs, not a mean
+    out.update(safety_totals(good))  # counts over the runs, not means; the smallest clearance
     return out
 
 
@@ -269,8 +271,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
 
 def format_table(figures: dict[str, Any]) -> str:
     """The comparison as a readable table (one column per variant)."""
-    keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "collisions", "path_length_m", "sim_time_s",
-            *CURVE_FIGURES]
+    keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "collisions", "safety_stops", "min_clearance_m",
+            "path_length_m", "sim_time_s", *CURVE_FIGURES]
     names = [n for n in VARIANTS if f"{n}.coverage" in figures]
     lines = [f"exploration in {figures['world']}: {figures['seeds']} seed(s), reachable floor "
              f"{figures['reachable_area_m2']:.1f} m^2 ({figures['criterion']})",

@@ -33,9 +33,13 @@ Figures (simulator ground truth, evaluation only):
   ``roadmap.room.reference_stamp`` (:class:`~experiments.eval.trajectory.TrueTrajectory`: exact,
   the robot stands still when it takes an image); position (m) and heading (deg) errors; within
   the issue's thresholds when <= 0.15 m and <= 5 deg;
-- per learn: targets found, whether the graph is connected, its edges, sim and wall time;
+- per learn: targets found, whether the graph is connected, its edges, sim and wall time; it
+  **succeeded** when the mission did, without a collision;
 - per goto: the report's true final pose against the goal's true pose; **reached** when the
-  mission succeeded and ended within 0.15 m and 5 deg of it.
+  mission succeeded without a collision and ended within 0.15 m and 5 deg of it;
+- per run: ``collisions`` (ground truth), ``safety_stops`` (the collision monitor's),
+  ``min_clearance_m`` (ground truth, when the simulator reports it), summed (the smallest
+  clearance) over the learns and over the gotos.
 
 An episode that fails, crashes or times out is a run with its status and reason (``failures``);
 a learn without a report found nothing and has no navigations. Roadmap files are written by the
@@ -55,7 +59,7 @@ import numpy as np
 from drivers.sim.floor import FloorGrid
 from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
-from experiments.eval.figures import cell, mean_present
+from experiments.eval.figures import cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.roadmap_world import (
     place_targets,
     pose_error,
@@ -280,7 +284,8 @@ def learn_figures(seed: int, report: Mapping[str, Any] | None, row: Mapping[str,
     """The figures of one learn run against the true poses of its targets (``truth``)."""
     out: dict[str, Any] = {"episode": "learn", "seed": seed, **_outcome(report, row), "targets": len(truth),
                            "found": 0, "target_errors": {}, "within": 0, "connected": False, "edges": 0,
-                           "sim_time_s": None, "wall_time_s": row.get("elapsed_s") if row else None}
+                           "sim_time_s": None, "wall_time_s": row.get("elapsed_s") if row else None,
+                           **safety_figures(report)}
     if report is None:
         return out
     section = report.get("roadmap", {})
@@ -306,7 +311,8 @@ def goto_figures(plan: GotoPlan, report: Mapping[str, Any] | None, row: Mapping[
     out: dict[str, Any] = {"episode": "goto", "seed": plan.episode.seed, "number": plan.episode.inputs["seed"],
                            "start": [round(start.x, 3), round(start.y, 3), round(math.degrees(start.theta), 1)],
                            "goal": plan.goal, **_outcome(report, row), "reached": False, "error_m": None,
-                           "error_deg": None, "sim_time_s": None, "wall_time_s": row.get("elapsed_s") if row else None}
+                           "error_deg": None, "sim_time_s": None, "wall_time_s": row.get("elapsed_s") if row else None,
+                           **safety_figures(report)}
     if report is None or "ground_truth" not in report:
         return out
     final = report["ground_truth"]["final_pose"]
@@ -314,7 +320,8 @@ def goto_figures(plan: GotoPlan, report: Mapping[str, Any] | None, row: Mapping[
     navigation = report.get("roadmap", {}).get("navigation", {})
     out.update({
         "error_m": round(distance, 4), "error_deg": round(heading, 3),
-        "reached": bool(out["status"] == "SUCCESS" and distance <= POSITION_OK and heading <= HEADING_OK),
+        "reached": bool(out["status"] == "SUCCESS" and out["collisions"] == 0 and distance <= POSITION_OK
+                        and heading <= HEADING_OK),
         "visited": navigation.get("visited"), "random_moves": navigation.get("random_moves"),
         "sim_time_s": report.get("sim_time_s"), "wall_time_s": report.get("wall_time_s", out["wall_time_s"]),
     })
@@ -346,8 +353,8 @@ def summarise(world: str, settings: Settings, learns: list[dict[str, Any]], goto
         "targets.source": settings.source,
         "targets.poses": pose_rows(poses or {}),
         "starts": settings.starts,
-        "criterion": f"within {POSITION_OK:g} m and {HEADING_OK:g} deg (a goto: and SUCCESS)",
-        "learn.succeeded": sum(run["status"] == "SUCCESS" for run in learns),
+        "criterion": f"within {POSITION_OK:g} m and {HEADING_OK:g} deg (a goto: and SUCCESS); a run: no collision",
+        "learn.succeeded": sum(run["status"] == "SUCCESS" and not run.get("collisions") for run in learns),
         "targets.found": sum(run["found"] for run in learns),
         "targets.total": len(settings.targets) * len(learns),
         "targets.within": sum(run["within"] for run in learns),
@@ -367,6 +374,8 @@ def summarise(world: str, settings: Settings, learns: list[dict[str, Any]], goto
         "goto.heading_error_mean_deg": mean_present([g["error_deg"] for g in measured]),
         "learn.sim_time_s": mean_present([run["sim_time_s"] for run in learns]),
         "learn.wall_time_s": mean_present([run["wall_time_s"] for run in learns]),
+        **{f"learn.{k}": v for k, v in safety_totals(learns).items()},
+        **{f"goto.{k}": v for k, v in safety_totals(gotos).items()},
     }
     out["failures"] = [_failure(run) for run in [*learns, *gotos] if run["status"] != "SUCCESS"]
     out["runs"] = [*learns, *gotos]
@@ -434,7 +443,7 @@ def format_table(figures: Mapping[str, Any]) -> str:
         f"roadmap in {f['world']}: {f['seeds']} seed(s), targets {', '.join(f['targets'])} "
         f"({f.get('targets.source', NAMED)}), {f['starts']} goto start(s) per seed; {f['criterion']}",
         f"learn: {f['learn.succeeded']} of {f['seeds']} succeeded; sim {cell(f['learn.sim_time_s'], 0)} s, wall "
-        f"{cell(f['learn.wall_time_s'], 0)} s (means)",
+        f"{cell(f['learn.wall_time_s'], 0)} s (means); {safety_cells(_prefixed(f, 'learn.'))}",
         f"targets found {f['targets.found']} of {f['targets.total']}, within {f['targets.within']}; error worst "
         f"{_pair(f['targets.position_error_worst_m'], f['targets.heading_error_worst_deg'])}, mean "
         f"{_pair(f['targets.position_error_mean_m'], f['targets.heading_error_mean_deg'])}",
@@ -442,9 +451,9 @@ def format_table(figures: Mapping[str, Any]) -> str:
         "edges (mean)",
         f"goto reached {f['goto.reached']} of {f['goto.run']} run ({f['goto.planned']} planned, rate "
         f"{cell(rate, 2)}); error worst {_pair(f['goto.error_worst_m'], f['goto.heading_error_worst_deg'])}, mean "
-        f"{_pair(f['goto.error_mean_m'], f['goto.heading_error_mean_deg'])}",
+        f"{_pair(f['goto.error_mean_m'], f['goto.heading_error_mean_deg'])}; {safety_cells(_prefixed(f, 'goto.'))}",
         "",
-        f"{'seed':>4} {'run':<18} {'status':<8} {'result':<38} {'error':<24} {'sim s':>7} {'wall s':>7}",
+        f"{'seed':>4} {'run':<18} {'status':<8} {'result':<38} {'error':<24} {'sim s':>7} {'wall s':>7}  obstacles",
     ]
     lines += [_run_line(run) for run in f["runs"]]
     if f.get("targets.source") == PLACED:
@@ -468,4 +477,8 @@ def _run_line(run: Mapping[str, Any]) -> str:
         result = "reached" if run["reached"] else "not reached"
         error = _pair(run["error_m"], run["error_deg"]) if run["error_m"] is not None else "-"
     return (f"{run['seed']:>4} {what:<18} {run['status']:<8} {result:<38} {error:<24} "
-            f"{cell(run['sim_time_s'], 0):>7} {cell(run['wall_time_s'], 0):>7}")
+            f"{cell(run['sim_time_s'], 0):>7} {cell(run['wall_time_s'], 0):>7}  {safety_cells(run)}")
+
+
+def _prefixed(figures: Mapping[str, Any], prefix: str) -> dict[str, Any]:
+    return {k[len(prefix):]: v for k, v in figures.items() if k.startswith(prefix)}

@@ -106,6 +106,18 @@ def test_summary_per_combination():
     assert table.splitlines()[0].split()[:2] == ["speed", "runs"] and "33%" in table and "goal_error_m" in table
 
 
+def test_a_success_that_collided_is_not_a_success():
+    rows = [{"id": f"e{i}", "mission": "m", "world": "lab", "seed": i, "max_time_s": None, "status": "SUCCESS",
+             "ground_truth.collisions": collisions, "safety.safety_stops": stops, "ground_truth.min_clearance_m": gap}
+            for i, (collisions, stops, gap) in enumerate([(0, 1, 0.12), (2, 0, 0.0), (0, 3, 0.08)])]
+    (entry,) = summarise(rows)
+    assert (entry["success"], entry["collided"], entry["success_rate"]) == (2, 1, 2 / 3)
+    assert entry["figures"]["safety.safety_stops"]["mean"] == pytest.approx(4 / 3)
+    assert entry["figures"]["ground_truth.min_clearance_m"]["min"] == 0.0
+    header = format_summary([entry]).splitlines()[0].split()
+    assert {"collided", "safety_stops", "min_clearance_m"} <= set(header)
+
+
 # --------------------------------------------------------------------------------------------
 # Sweeps
 
