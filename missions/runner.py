@@ -27,7 +27,9 @@ and the last command recorded (report and recording) is a zero velocity.
 Capabilities add to the report and the recording without touching the runner: any node of the
 tree may define ``report_sections() -> dict`` (merged into the report by section name: the
 ``ltmap``, ``roadmap`` and ``exploration`` sections of DESIGN.md) and ``log_rerun(rec)`` (called
-after every recorded tick). Behaviours still never see ground truth: the simulator adds its
+after every recorded tick). A driver of the robot may add sections the same way
+(``report_sections() -> dict``: the Pioneer base says which model and conversion factors it
+used, and where they came from). Behaviours still never see ground truth: the simulator adds its
 ``ground_truth`` section as an observer, and evaluations combine the two.
 """
 
@@ -319,6 +321,10 @@ class Runner:
             report.update(observer.report_sections(mission.evaluation))
         for name, values in self._node_sections().items():
             report.setdefault(name, {}).update(values)
+        for device in (self.robot.base, self.robot.ptu):
+            sections = getattr(device, "report_sections", None)
+            if callable(sections):
+                report.update(sections())
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}
