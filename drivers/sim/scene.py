@@ -361,17 +361,24 @@ class Scene:
         return self.clearance(x, y) < radius
 
 
-def free_space_problem(world: World, pose: Pose2D) -> str | None:
-    """Why the robot cannot stand at ``pose`` (too close to a wall, box or pillar), or None.
+def free_space_problem(world: World, pose: Pose2D, *, people: bool = True) -> str | None:
+    """Why the robot cannot stand at ``pose`` (too close to a wall, box or pillar, or with
+    ``people`` on a person where they are at time 0), or None.
 
-    The world loader checks the start pose with it, ``bearings run --start`` a pose given on the
-    command line.
+    The world loader checks the start pose with it (people apart: it names the person), ``bearings
+    run --start`` a pose given on the command line.
     """
     clearance = Scene(world).clearance(pose.x, pose.y)
-    if clearance >= world.robot_radius:
-        return None
-    return (f"({pose.x:g}, {pose.y:g}) is not in free space: {max(clearance, 0.0):.2f} m from a wall, box or "
-            f"pillar, less than the robot radius {world.robot_radius:g} m")
+    if clearance < world.robot_radius:
+        return (f"({pose.x:g}, {pose.y:g}) is not in free space: {max(clearance, 0.0):.2f} m from a wall, box or "
+                f"pillar, less than the robot radius {world.robot_radius:g} m")
+    for index, person in enumerate(world.people if people else ()):
+        x, y = position_at(person, 0.0)
+        gap = math.hypot(x - pose.x, y - pose.y) - person.radius
+        if gap < world.robot_radius:
+            return (f"({pose.x:g}, {pose.y:g}) is on person {index} (at ({x:g}, {y:g}) at the start): "
+                    f"{max(gap, 0.0):.2f} m from them, less than the robot radius {world.robot_radius:g} m")
+    return None
 
 
 def _surface_texture(spec: TextureSpec, length: float, height: float) -> np.ndarray:

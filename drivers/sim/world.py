@@ -217,7 +217,7 @@ def _whole_world_problems(world: World, data: YamlMap, file: str) -> list[Diagno
 
 
 def _start_problems(world: World, data: YamlMap, file: str) -> list[Diagnostic]:
-    problem = free_space_problem(world, world.start)
+    problem = free_space_problem(world, world.start, people=False)
     if problem is None:
         return _people_on_start(world, data, file)
     mark = data.value_mark_of("start") if "start" in data else data.mark

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from drivers.sim.people import PERSONAL_SPACE_M, position_at
+from drivers.sim.scene import free_space_problem
 from drivers.sim.world import load_world
 from drivers.sim.world_values import Person, TextureSpec
 from maps.store import InputError
@@ -160,3 +161,10 @@ def test_a_persons_path_may_cross_a_wall(world_file):
     world = load_world(world_file(HALL + "people: [{path: [[0, 2], [0, 5]], wait_s: 2, texture: {seed: 4}}]\n"))
     assert world.people[0].path == ((0.0, 2.0), (0.0, 5.0)) and world.people[0].wait == 2.0
     assert world.people[0].texture.seed == 4
+
+
+def test_a_start_pose_on_a_person_is_not_free(world_file):
+    world = load_world(world_file(HALL + "people: [{path: [[2, 0], [2, 2]]}]\n"))
+    assert free_space_problem(world, Pose2D(0, 0)) is None
+    assert "is on person 0 (at (2, 0) at the start): 0.15 m" in free_space_problem(world, Pose2D(1.6, 0))
+    assert free_space_problem(world, Pose2D(1.6, 0), people=False) is None
