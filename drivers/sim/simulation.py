@@ -179,12 +179,14 @@ class Simulation:
         drive.step(dt, blocked=False)
         after_true, after_odom = drive.true_pose.copy(), drive.odom_pose.copy()
         radius = self.world.robot_radius
-        clearance, at_end, by_person = self._swept_clearance(before_true[:2], after_true[:2], radius)
+        swept = self._swept_clearance(before_true[:2], after_true[:2], radius)
+        clearance, at_end, by_person, fixed_at_end = swept
         # blocked: touching, and closer than before (a robot in contact may still back away)
         if clearance < radius and clearance < self._clearance(before_true[0], before_true[1]) - 1e-12:
             f = self._contact_fraction(before_true[:2], after_true[:2], radius)
             drive.true_pose = _between(before_true, after_true, f)
             drive.odom_pose = _between(before_odom, after_odom, f)
+            fixed_at_end = self.scene.clearance(*drive.true_pose[:2])
             drive.velocity = (0.0, 0.0)
             if not self._in_contact:  # a new contact episode (not the same push, step after step)
                 self.collisions += 1
@@ -199,24 +201,27 @@ class Simulation:
         self.scene.move_people(self.crowd.xy)
         self.ptu.step(dt)
         self.time += dt
-        self.min_clearance = min(self.min_clearance, self._clearance(*drive.true_pose[:2]) - radius)
+        here = min(fixed_at_end, self.crowd.clearance(*drive.true_pose[:2]))  # the people have moved
+        self.min_clearance = min(self.min_clearance, here - radius)
         self.truth.record(self.time, drive.true(self.time), drive.odometry(self.time))
 
     def _clearance(self, x: float, y: float) -> float:
         """Distance (m) from (x, y) to the nearest wall, box face, pillar or person."""
         return min(self.scene.clearance(x, y), self.crowd.clearance(x, y))
 
-    def _swept_clearance(self, start: np.ndarray, end: np.ndarray, radius: float) -> tuple[float, float, bool]:
+    def _swept_clearance(self, start: np.ndarray, end: np.ndarray,
+                         radius: float) -> tuple[float, float, bool, float]:
         """The smallest clearance along a step's straight path, sampled every radius / 2 (so a long
-        step cannot jump over a thin wall), the clearance at its end, and whether a person is the
-        nearest thing where the clearance is smallest."""
+        step cannot jump over a thin wall), the clearance at its end, whether a person is the
+        nearest thing where the clearance is smallest, and the walls', boxes' and pillars' alone at
+        its end."""
         samples = max(1, math.ceil(math.hypot(end[0] - start[0], end[1] - start[1]) / (radius / 2.0)))
         points = [start + (end - start) * (i / samples) for i in range(1, samples + 1)]
         fixed = [self.scene.clearance(*p) for p in points]
-        people = [self.crowd.clearance(*p) for p in points]
+        people = [self.crowd.clearance(*p) for p in points] if len(self.crowd) else [math.inf] * samples
         values = [min(a, b) for a, b in zip(fixed, people, strict=True)]
-        nearest = int(np.argmin(values))
-        return values[nearest], values[-1], people[nearest] < fixed[nearest]
+        nearest = min(range(samples), key=values.__getitem__)
+        return values[nearest], values[-1], people[nearest] < fixed[nearest], fixed[-1]
 
     def _contact_fraction(self, start: np.ndarray, end: np.ndarray, radius: float) -> float:
         """The largest fraction of a blocked step (start -> end) the robot can drive before its disc
