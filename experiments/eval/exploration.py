@@ -45,7 +45,6 @@ from typing import Any
 import cv2
 import numpy as np
 
-from behaviours.exploration import unpack_cells
 from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.simulation import start_to_world
 from drivers.sim.world import load_world
@@ -54,7 +53,10 @@ from experiments.eval import people as crowd
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.table import read_report
-from maps.exploration import GridFrame, StereoHead, scan_cells
+from maps.exploration.codec import unpack_cells
+from maps.exploration.grid import GridFrame
+from maps.exploration.head import StereoHead
+from maps.exploration.integrate import scan_cells
 from perception.geometry import Pose2D
 
 DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed"
