@@ -101,17 +101,6 @@ class Camera(Protocol):
 
 
 @runtime_checkable
-class KeySource(Protocol):
-    """Keys typed by an operator (teleoperation); ``read`` never blocks."""
-
-    def read(self) -> list[str]:
-        """The keys typed since the last call, oldest first (possibly none): ``up``, ``space``, ``q``, ..."""
-
-    def close(self) -> None:
-        """Give the input back (restore the terminal)."""
-
-
-@runtime_checkable
 class RangeSource(Protocol):
     """Range sensors and bumpers around the base (a sonar ring, the simulator's model of one)."""
 
@@ -120,6 +109,17 @@ class RangeSource(Protocol):
 
     def close(self) -> None:
         """Release the device."""
+
+
+@runtime_checkable
+class KeySource(Protocol):
+    """Keys typed by an operator (teleoperation); ``read`` never blocks."""
+
+    def read(self) -> list[str]:
+        """The keys typed since the last call, oldest first (possibly none): ``up``, ``space``, ``q``, ..."""
+
+    def close(self) -> None:
+        """Give the input back (restore the terminal)."""
 
 
 KeyboardOpener = Callable[[], KeySource]
@@ -151,9 +151,9 @@ class Robot:
                 stop()
 
     def close(self) -> None:
-        """Stop, then release every device (cameras, pan-tilt, base last)."""
+        """Stop, then release every device (cameras, range sensors, pan-tilt, base last)."""
         self.stop_all()
-        devices = [*self.cameras.values(), self.ptu, self.base]
+        devices = [*self.cameras.values(), self.ranges, self.ptu, self.base]
         for device in devices:
             if device is None:
                 continue

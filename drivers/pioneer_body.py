@@ -33,6 +33,7 @@ SONAR_FOV = math.radians(30.0)  # the transducer's cone
 SONAR_MAX_RANGE = 5.0  # m: ArSonarDevice's default maximum; farther (or 5000 mm: no echo) is no echo
 SONAR_MIN_RANGE = 0.1  # m: nearer objects are not seen (ringing)
 BUMPER_ARC_DEG = 135.0  # ArBumpers' default angleRange
+RING_SIZE = 8  # transducers per ring: front 0-7 (left to right), rear 8-15 (right to left)
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,19 +54,21 @@ class PioneerBody:
         """The box of ``RobotLengthFront/Rear`` by ``RobotWidth`` about the centre of rotation."""
         return rectangle(self.length_front, self.length_rear, self.width / 2.0)
 
-    def sensors(self) -> tuple[RangeSensor, ...]:
+    def sensors(self, max_range: float = SONAR_MAX_RANGE) -> tuple[RangeSensor, ...]:
         """The sonar ring as :class:`RangeSensor` (index = ARIA's transducer number)."""
-        return tuple(RangeSensor(x / 1000.0, y / 1000.0, math.radians(heading), SONAR_FOV, SONAR_MAX_RANGE,
+        return tuple(RangeSensor(x / 1000.0, y / 1000.0, math.radians(heading), SONAR_FOV, max_range,
                                  SONAR_MIN_RANGE) for x, y, heading in self.sonar)
 
-    def bumpers(self) -> tuple[Bumper, ...]:
-        """Front bumpers, then rear bumpers, where ARIA places their hits."""
+    def bumpers(self, radius: float | None = None) -> tuple[Bumper, ...]:
+        """Front bumpers, then rear bumpers, where ARIA places their hits, on the circle of
+        ``RobotRadius`` (or of ``radius``: the simulator's collision disc)."""
+        radius = self.radius if radius is None else radius
         out = []
         for count, facing in ((self.front_bumpers, 1), (self.rear_bumpers, -1)):
             for i in range(count):
                 degrees = -((i + 0.5) * BUMPER_ARC_DEG / count - BUMPER_ARC_DEG / 2.0) + (0.0 if facing > 0 else 180.0)
                 angle = math.radians(degrees)
-                out.append(Bumper(self.radius * math.cos(angle), self.radius * math.sin(angle), facing))
+                out.append(Bumper(radius * math.cos(angle), radius * math.sin(angle), facing))
         return tuple(out)
 
     def scan(self, sonar: Mapping[int, float], silent: Collection[int], front_bits: int, rear_bits: int,

@@ -41,6 +41,12 @@ Maps are written by the teach episodes into the results folder and read by the r
 this module: on a Dask cluster (``--cluster``) that folder (``-o DIR``) must be one the workers and
 this machine share.
 
+People (``--option people=N``, :mod:`experiments.eval.people`): N people drawn from the seed,
+standing on the taught route or walking across it, none within 1 m of its start or end, are added
+to a copy of the world file (``people/s<seed>/<world>.yaml`` in the results folder) that the
+seed's repeats run in; the teach runs in the world as it is (the route is taught, then repeated
+home with people in it). The figures record the people placed (``people.placed``, ``people.paths``).
+
 A row (per number of levels cut, 0 = the full tree; its ``height`` is the same for every seed
 unless seeds taught trees of different heights, then the range) holds the means over its seeds,
 ``goal_reached`` of ``seeds``, and over its repeats the collisions and safety stops summed and the
@@ -60,6 +66,7 @@ import numpy as np
 from drivers.sim.simulation import path_distances
 from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
+from experiments.eval import people as crowd
 from experiments.eval.figures import cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.ltmap_route import Route, default_route, given_route, parse_route
 from experiments.eval.trajectory import TrueTrajectory
@@ -81,6 +88,7 @@ OPTIONS = {
                       "(default: the robot's diameter or the taught viewframes' spacing, whichever is larger)",
     "rotation": "how the repeat estimates its rotation: zinf (Z-infinity, the paper; default) or compass (the "
                 "median bearing change of every landmark: the comparison for worlds with near landmarks)",
+    crowd.OPTION: crowd.HELP + " (the repeats': on the taught route or across it)",
 }
 ROTATIONS = ("zinf", "compass")
 TEACH, FOLLOW = "teach_route", "follow_route"
@@ -99,6 +107,7 @@ class Settings:
     min_landmarks: int | None  # None: from the map (module docstring)
     goal_tolerance: float | None  # m; None: per seed from the robot and the map (module docstring)
     rotation: str = "zinf"  # FollowRoute's rotation estimate (ROTATIONS)
+    people: int = 0  # people in the repeats' world
 
 
 def check_world(world: str) -> World:
@@ -132,7 +141,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     rotation = extra.get("rotation", "zinf")
     if rotation not in ROTATIONS:
         raise ValueError(f"rotation must be one of {', '.join(ROTATIONS)}, got {rotation!r}")
-    return Settings(camera, route, min_landmarks, tolerance, rotation)
+    return Settings(camera, route, min_landmarks, tolerance, rotation, crowd.parse_people(extra.get(crowd.OPTION)))
 
 
 def _number(text: str, name: str, kind: type[int] | type[float]) -> Any:
@@ -193,8 +202,9 @@ def teach_episode(world: str, seed: int, settings: Settings, folder: Path, max_t
 
 
 def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_landmarks: int,
-                   max_time_s: float | None, rotation: str = "zinf") -> Episode:
-    """The repeat of ``teach``'s map cut by ``level.cut`` levels, from the teach's true end pose."""
+                   max_time_s: float | None, rotation: str = "zinf", world: str | None = None) -> Episode:
+    """The repeat of ``teach``'s map cut by ``level.cut`` levels, from the teach's true end pose, in
+    ``world`` (default: the teach's)."""
     end = report["ground_truth"]["final_pose"]
     start = f"{end['x']:.4f},{end['y']:.4f},{math.degrees(end['theta']):.3f}deg"
     inputs: dict[str, Any] = {"map": teach.inputs["map"], "camera": teach.inputs["camera"], "direction": "reverse",
@@ -206,7 +216,7 @@ def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_
     if max_time_s is None:
         a, b = REPEAT_TIME
         max_time_s = float(math.ceil((a + b * float(report.get("sim_time_s", 0.0))) / 10.0) * 10.0)
-    return Episode(FOLLOW, teach.world, teach.seed, inputs, max_time_s, start)
+    return Episode(FOLLOW, world or teach.world, teach.seed, inputs, max_time_s, start)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -322,6 +332,20 @@ def _teach_phase(options: EvalOptions, settings: Settings, folder: Path,
     return {seed: (episode, read_report(folder, episode.id)) for seed, episode in episodes.items()}
 
 
+def repeat_worlds(world: str, loaded: World, settings: Settings, seeds: list[int],
+                  folder: Path) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
+    """Per seed, the world its repeats run in (with ``settings.people`` people on or across the
+    route: module docstring) and those people; the world itself when there are none."""
+    if not settings.people:
+        return {seed: world for seed in seeds}, {}
+    route = settings.route.world_xy
+    people = {seed: crowd.on_ways(loaded, [route], settings.people, seed, keep_clear=[route[0], route[-1]])
+              for seed in seeds}
+    worlds = {seed: str(crowd.world_with_people(world, folder / "people" / f"s{seed:04d}" / f"{Path(world).stem}.yaml",
+                                          people[seed])) for seed in seeds}
+    return worlds, people
+
+
 def _taught(teach: Episode, report: dict[str, Any] | None) -> LandmarkTree | str:
     """The saved map of a teach that succeeded, else why there is none."""
     path = Path(teach.inputs["map"])
@@ -338,6 +362,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Teach on every seed, repeat from every tree height, compute the Table-I figures."""
     world, settings = options.checked or (check_world(options.world), check_options(options.world, options.extra))
     folder = Path(options.results_dir).resolve()
+    repeat_world, people = repeat_worlds(options.world, world, settings, options.seeds, folder)
     teaches = _teach_phase(options, settings, folder, resume)
     plan: list[tuple[Episode, Run, Level]] = []
     failed, teach_rows = [], []
@@ -355,8 +380,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
                            "goal_tolerance_m": tolerance[seed],
                            "path_length_m": report["ground_truth"]["trajectory_length_m"],
                            "sim_time_s": report.get("sim_time_s"), **safety_figures(report)})
-        plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation), taught, level)
-                 for level in levels(tree, minimum)]
+        plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation,
+                                 repeat_world[seed]), taught, level) for level in levels(tree, minimum)]
     if plan:  # every repeat at once: the pool runs them in parallel
         run_sweep([episode for episode, _, _ in plan], executor=options.executor, results_dir=folder,
                   timeout_s=options.timeout_s, progress=options.progress, resume=True)
@@ -364,7 +389,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     for episode, taught, level in plan:
         figures = repeat_figures(taught, read_report(folder, episode.id), level, tolerance[episode.seed])
         runs.append({"seed": episode.seed, **figures})
-    return summarise(world, settings, len(options.seeds), teach_rows, failed, runs)
+    out = summarise(world, settings, len(options.seeds), teach_rows, failed, runs)
+    return {**out, **crowd.figures(people, settings.people)} if settings.people else out
 
 
 def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dict[str, Any]],
@@ -454,6 +480,7 @@ def format_table(figures: Mapping[str, Any]) -> str:
         lines.append(f"goal reached by every seed down to {cell(still, 1)} % memory; first missed at "
                      f"{cell(lost, 1)} %")
     lines.append(f"teaching: {safety_cells({k[6:]: v for k, v in figures.items() if k.startswith('teach.')})}")
+    lines += crowd.table_line(figures)
     for fail in figures["teach_failed"]:
         lines.append(f"seed {fail['seed']}: no map to repeat ({fail['problem']})")
     if figures.get("warning"):

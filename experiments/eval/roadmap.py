@@ -41,6 +41,13 @@ Figures (simulator ground truth, evaluation only):
   ``min_clearance_m`` (ground truth, when the simulator reports it), summed (the smallest
   clearance) over the learns and over the gotos.
 
+People (``--option people=N``, :mod:`experiments.eval.people`): N people drawn from the seed,
+standing on or walking across the straight lines between the seed's targets, none within 1 m of a
+target, the start or a navigation's start, are added to a copy of the seed's world file
+(``seeds/<world>_s<seed>/people/<world>.yaml``) that the seed's navigations run in; the target
+images and the learning see the world as it is. The figures record the people placed
+(``people.placed``, ``people.paths``).
+
 An episode that fails, crashes or times out is a run with its status and reason (``failures``);
 a learn without a report found nothing and has no navigations. Roadmap files are written by the
 learn episodes and read by the goto episodes: on a Dask cluster the results folder must be shared.
@@ -59,6 +66,7 @@ import numpy as np
 from drivers.sim.floor import FloorGrid
 from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
+from experiments.eval import people as crowd
 from experiments.eval.figures import cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.roadmap_world import (
     place_targets,
@@ -84,6 +92,7 @@ OPTIONS = {
                "of targets placed in the free space from the seed (default: every named pose the robot can stand "
                "at and reach from the start; 4 placed when fewer than 2)",
     "starts": f"random start poses per seed to navigate from (default {DEFAULT_STARTS}; 0: learning only)",
+    crowd.OPTION: crowd.HELP + " (the navigations': between the targets)",
 }
 LEARN, GOTO = "learn_targets", "goto_target"
 POSITION_OK, HEADING_OK = 0.15, 5.0  # m, deg: the issue's thresholds for a target and a navigation
@@ -101,6 +110,7 @@ class Settings:
     targets: tuple[str, ...]
     starts: int
     source: str = NAMED
+    people: int = 0  # people in the navigations' world
 
 
 @dataclass(frozen=True)
@@ -152,7 +162,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     starts = parse_starts(extra.get("starts"))
     if starts:
         random_starts(loaded, 1, 0, grid=grid)  # ValueError: nowhere clear enough to start from
-    return Settings(targets, starts, source)
+    return Settings(targets, starts, source, crowd.parse_people(extra.get(crowd.OPTION)))
 
 
 def choose_targets(text: str | None, world: World, usable: Mapping[str, Pose2D]) -> tuple[tuple[str, ...], str]:
@@ -244,9 +254,10 @@ def learn_episode(world: str, seed: int, folder: Path, max_time_s: float | None)
 
 
 def goto_plans(learn: Episode, world: World, found: Sequence[str], starts: int,
-               max_time_s: float | None, grid: FloorGrid | None = None) -> list[GotoPlan]:
+               max_time_s: float | None, grid: FloorGrid | None = None, run_in: str | None = None) -> list[GotoPlan]:
     """The seed's navigations: random starts (``random_starts``), goals drawn among ``found``; the
-    mission's own ``seed`` (its random moves) is the navigation's number."""
+    mission's own ``seed`` (its random moves) is the navigation's number. They run in the world
+    file ``run_in`` (default: the learning's)."""
     poses = random_starts(world, starts, learn.seed, grid=grid)
     rng = np.random.default_rng([learn.seed, 0x60A2])
     goals = [found[int(i)] for i in rng.integers(len(found), size=starts)] if found else []
@@ -254,8 +265,26 @@ def goto_plans(learn: Episode, world: World, found: Sequence[str], starts: int,
     for k, (start, goal) in enumerate(zip(poses, goals, strict=True)):
         where = f"{start.x:.4f},{start.y:.4f},{math.degrees(start.theta):.3f}deg"
         inputs = {"roadmap": learn.inputs["roadmap"], "target": goal, "seed": k}
-        plans.append(GotoPlan(Episode(GOTO, learn.world, learn.seed, inputs, max_time_s, where), start, goal))
+        plans.append(GotoPlan(Episode(GOTO, run_in or learn.world, learn.seed, inputs, max_time_s, where), start, goal))
     return plans
+
+
+def navigation_worlds(loaded: World, settings: Settings, targets: Mapping[int, SeedTargets], folder: Path,
+                      grid: FloorGrid | None) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
+    """Per seed, the world its navigations run in (with ``settings.people`` people between the
+    targets: module docstring) and those people; the seed's world itself when there are none."""
+    if not settings.people:
+        return {seed: t.world for seed, t in targets.items()}, {}
+    worlds, people = {}, {}
+    for seed, t in targets.items():
+        spots = [(p.x, p.y) for p in t.poses.values()]
+        ways = [np.array([a, b]) for i, a in enumerate(spots) for b in spots[i + 1:]]
+        clear = [*spots, (loaded.start.x, loaded.start.y),
+                 *((p.x, p.y) for p in random_starts(loaded, settings.starts, seed, grid=grid))]
+        people[seed] = crowd.on_ways(loaded, ways, settings.people, seed, keep_clear=clear)
+        here = seed_folder(folder, t.world, seed) / "people" / f"{Path(world_path(t.world)).stem}.yaml"
+        worlds[seed] = str(crowd.world_with_people(t.world, here, people[seed]))
+    return worlds, people
 
 
 def _outcome(report: Mapping[str, Any] | None, row: Mapping[str, Any] | None) -> dict[str, Any]:
@@ -409,6 +438,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     grid = reachable_grid(loaded)  # once: every seed's placed targets and random starts
     targets = {seed: seed_targets(world, loaded, settings, seed, folder, grid) for seed in options.seeds}
     truth = {seed: t.poses for seed, t in targets.items()}
+    navigate_in, people = navigation_worlds(loaded, settings, targets, folder, grid)
     episodes, rows = _learn_phase(options, targets, settings, folder, resume)
     learns, plans = [], []
     for seed, episode in sorted(episodes.items()):
@@ -416,7 +446,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         learns.append(figures)
         found = sorted(figures["target_errors"])
         if settings.starts and found and Path(episode.inputs["roadmap"]).is_file():
-            plans += goto_plans(episode, loaded, found, settings.starts, options.max_time_s, grid)
+            plans += goto_plans(episode, loaded, found, settings.starts, options.max_time_s, grid, navigate_in[seed])
     rows = {}
     if plans:  # every navigation at once: the pool runs them in parallel
         done = run_sweep([p.episode for p in plans], executor=options.executor, results_dir=folder,
@@ -424,7 +454,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         rows = {row["id"]: row for row in done}
     gotos = [goto_figures(p, read_report(folder, p.episode.id), rows.get(p.episode.id), truth[p.episode.seed][p.goal])
              for p in plans]
-    return summarise(loaded.name, settings, learns, gotos, truth)
+    out = summarise(loaded.name, settings, learns, gotos, truth)
+    return {**out, **crowd.figures(people, settings.people)} if settings.people else out
 
 
 # ------------------------------------------------------------------------------------------------
@@ -460,6 +491,7 @@ def format_table(figures: Mapping[str, Any]) -> str:
         lines += [f"seed {seed} placed targets: " + ", ".join(f"{n} ({x:g}, {y:g}, {deg:g} deg)"
                                                                for n, (x, y, deg) in by_name.items())
                   for seed, by_name in f["targets.poses"].items()]
+    lines += crowd.table_line(f)
     lines += [f"seed {x['seed']} {x['episode']}: {x['status']}: {x['reason']}" for x in f["failures"]]
     return "\n".join(lines)
 

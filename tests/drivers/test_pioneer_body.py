@@ -35,3 +35,16 @@ def test_bumpers_sit_where_aria_places_their_hits():
     assert all(b.facing == 1 for b in front) and all(b.facing == -1 for b in rear)
     assert math.hypot(front[2].x, front[2].y) == pytest.approx(0.25)
     assert (rear[2].x, rear[2].y) == pytest.approx((-0.25, 0.0))
+
+
+def test_the_p3at_ring_sits_further_forward_with_the_same_headings():
+    dx, at = BODIES["p3dx"].sensors(), BODIES["p3at"].sensors(max_range=4.0)
+    assert at[3].x == pytest.approx(0.245) and at[3].x > dx[3].x  # SonarUnit 3 245 27 10 of params/p3at.p
+    assert [s.heading for s in at] == [s.heading for s in dx]
+    assert all(s.max_range == 4.0 for s in at)
+
+
+def test_the_simulator_puts_the_bumpers_on_its_own_disc():
+    bumpers = BODIES["p3dx"].bumpers(0.26)
+    assert all(math.hypot(b.x, b.y) == pytest.approx(0.26) for b in bumpers)
+    assert (bumpers[2].x, bumpers[2].y) == pytest.approx((0.26, 0.0))
