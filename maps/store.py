@@ -251,6 +251,48 @@ def output_problem(path: str | os.PathLike) -> str | None:
     return None
 
 
+@dataclass(frozen=True, slots=True)
+class OutputFolders:
+    """Where a mission's files go: relative paths resolve against ``base``, and a file the mission
+    writes must lie inside one of ``roots`` (its own folder, the ``--output-dir``) once every
+    symbolic link on the way is followed, so neither ``/any/where`` nor ``..`` nor a link inside
+    the folder that points out can make it write elsewhere. Both are absolute, links resolved."""
+
+    base: Path
+    roots: tuple[Path, ...]
+
+    @classmethod
+    def of(cls, base: str | os.PathLike, *roots: str | os.PathLike) -> OutputFolders:
+        real = Path(os.path.realpath(base))
+        return cls(real, tuple(dict.fromkeys([real, *(Path(os.path.realpath(r)) for r in roots)])))
+
+    def resolve(self, text: str) -> Path:
+        """The file a port's text names: absolute, every existing symbolic link followed."""
+        return Path(os.path.realpath(self.base / os.fspath(text)))
+
+    def outside(self, text: str) -> str | None:
+        """Why a file the mission would write at ``text`` is refused (outside every root), or None."""
+        target = self.resolve(text)
+        if any(target == root or root in target.parents for root in self.roots):
+            return None
+        where = " or ".join(str(root) for root in self.roots)
+        via = f" (through a symbolic link: {target})" if target != Path(os.path.abspath(self.base / text)) else ""
+        return f"{text!r} is outside the mission's output folder {where}{via}: give --output-dir to write elsewhere"
+
+
+def check_not_redirected(path: str | os.PathLike) -> None:
+    """``OSError`` when a file a mission writes is now reached through a symbolic link: the loader
+    gave the node an absolute path with every link resolved (:class:`OutputFolders`), so a link
+    there now (or in an absolute path's folders) was put in its way since and must not take the
+    write out of the output folder."""
+    text = os.fspath(path)
+    folder = os.path.dirname(text)
+    moved = os.path.isabs(text) and os.path.realpath(folder) != os.path.normpath(folder)
+    if os.path.islink(text) or moved:
+        raise OSError(f"{text} is reached through a symbolic link (to {os.path.realpath(text)}); a mission's "
+                      "file is not written through one")
+
+
 def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
     """Write ``data`` so that ``path`` holds either the old content or all of the new one.
 

@@ -63,7 +63,7 @@ from typing import Any
 
 import numpy as np
 
-from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.ports import WRITES, InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import RoadmapDisplay, roadmap_section
 from behaviours.roadmap.homing import REQUIRED_ROOM, HomingSettings, home
@@ -76,6 +76,7 @@ from maps.planning import segment_is_free
 from maps.pose_graph import refine_targets
 from maps.roadmap import EdgeMotion, InconsistentEstimates, Roadmap
 from maps.room import RoomEstimate
+from maps.store import check_not_redirected
 from perception.geometry import Pose2D, wrap_angle
 
 TURN_NOISE = 0.01  # sigma per radian turned (calibrated turns)
@@ -130,7 +131,7 @@ class BuildGraph(RoutineBehaviour):
         InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the targets found (reference frame)"),
         InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the target images"),
         InputPort("reference", TargetView, Ref("/map/reference_image"), doc="the image taken at the reference"),
-        InputPort("file", str, "", doc="where to save the roadmap ('' : do not save)"),
+        InputPort("file", str, "", literal_only=True, file=WRITES, doc="where to save the roadmap ('' : do not save)"),
         *REQUIRED_ROOM,
         *PLAN_PORTS,
         *ROUTINE_PORTS,
@@ -283,6 +284,7 @@ class BuildGraph(RoutineBehaviour):
         path = self.get_input("file")
         if path:
             try:
+                check_not_redirected(path)  # checked at load to lie in the output folder: no link since
                 relative_images(self.graph, path).save(path)
             except (OSError, ValueError) as exc:
                 raise Failed(f"cannot save the roadmap to {path}: {exc}") from None

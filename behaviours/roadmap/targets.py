@@ -22,7 +22,7 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.ports import READS, InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import RoadmapDisplay, roadmap_section
 from behaviours.roadmap.values import HomingResult, TargetImages, TargetView
@@ -79,7 +79,7 @@ class LoadTargetImages(BearingsBehaviour):
     """
 
     PORTS = (
-        InputPort("folder", str, doc="folder of target images (PNG, JPEG, ...); target name = file name"),
+        InputPort("folder", str, file=READS, doc="folder of target images (PNG, JPEG, ...); target name = file name"),
         InputPort("max_features", int, FEATURES, minimum=50, maximum=20000, literal_only=True,
                   doc="SIFT features per image"),
         OutputPort("targets", TargetImages, "/map/target_images", doc="the target images with their features"),
@@ -102,7 +102,7 @@ class LoadRoadmap(BearingsBehaviour):
     """Read a roadmap file and the target images it names (paths relative to the file's folder)."""
 
     PORTS = (
-        InputPort("file", str, doc="roadmap file written by learn_targets"),
+        InputPort("file", str, file=READS, doc="roadmap file written by learn_targets"),
         InputPort("max_features", int, FEATURES, minimum=50, maximum=20000, literal_only=True,
                   doc="SIFT features per image"),
         OutputPort("roadmap", Roadmap, "/map/roadmap", doc="targets (reference frame) and edges"),

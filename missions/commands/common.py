@@ -19,6 +19,10 @@ EXIT_OK, EXIT_FAILURE, EXIT_INVALID = 0, 1, 2
 def add_mission_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
                         help="override a mission input (repeatable); the value is parsed as YAML (2, true, abc)")
+    parser.add_argument("--output-dir", type=Path, metavar="DIR",
+                        help="where the mission's files go (maps it saves): relative paths resolve here, and a "
+                             "file outside DIR and the mission's folder is refused (default: the mission's "
+                             "folder; the current one for a shipped mission)")
     parser.add_argument("--path", dest="search_path", action="append", default=[], metavar="DIR",
                         help="extra folder where 'include:' looks for mission files (repeatable; "
                              "also $BEARINGS_PATH)")
@@ -40,7 +44,8 @@ def parse_sets(sets: list[str]) -> dict[str, str]:
 
 
 def load_from_args(path: str, args: argparse.Namespace) -> MissionSpec:
-    return load_mission(path, overrides=parse_sets(args.sets), search_path=args.search_path)
+    return load_mission(path, overrides=parse_sets(args.sets), search_path=args.search_path,
+                        output_dir=getattr(args, "output_dir", None))
 
 
 def print_input_error(exc: InputError) -> int:

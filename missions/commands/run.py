@@ -14,6 +14,7 @@ from maps.store import Diagnostic, InputError, output_problem, write_json
 from missions.clocks import Paced, WallClock
 from missions.commands.common import add_mission_options, load_from_args, parse_pose, print_input_error
 from missions.model import RunArguments
+from missions.outputs import prepare_written_files
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
 from perception.geometry import Pose2D
@@ -66,6 +67,7 @@ def run(args: argparse.Namespace) -> int:
             numbers = _numbers(args)
             _prepare_outputs(args)
             mission = load_from_args(args.mission, args)
+            prepare_written_files(mission, lambda note: print(f"bearings run: {note}", file=sys.stderr))
             simulation, robot, clock = _open(args, numbers.seed)
         except InputError as exc:
             return print_input_error(exc)
