@@ -13,13 +13,15 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import re
+import stat
 import tempfile
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import yaml
 
@@ -193,23 +195,45 @@ def parse_yaml(text: str, *, file: str = "<string>") -> Any:
             loader.dispose()
 
 
-def read_bytes(path: str | os.PathLike, *, limit: int, what: str) -> bytes:
-    """The bytes of a file named by the user, at most ``limit`` of them (``/dev/zero`` or a 300 MB
-    line must not fill memory); a clear :class:`InputError` on any failure. ``what`` names the
-    kind of file in the too-large message."""
+def open_regular(path: str | os.PathLike) -> BinaryIO:
+    """A regular file named by the user, open for reading; :class:`InputError` in one line for
+    anything else. Opened without blocking and checked before a byte is read: a FIFO would block
+    until someone writes to it, ``/dev/zero`` never ends, a directory is not a file."""
     name = str(path)
     try:
-        with open(path, "rb") as handle:
-            data = handle.read(limit + 1)
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     except FileNotFoundError:
         raise InputError([Diagnostic(name, 0, 0, "no such file")]) from None
     except IsADirectoryError:
         raise InputError([Diagnostic(name, 0, 0, "is a directory, not a file")]) from None
     except OSError as exc:
         raise InputError([Diagnostic(name, 0, 0, f"cannot read: {exc.strerror}")]) from None
+    mode = os.fstat(fd).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        what = "a directory" if stat.S_ISDIR(mode) else "a pipe" if stat.S_ISFIFO(mode) else "a device or socket"
+        raise InputError([Diagnostic(name, 0, 0, f"is {what}, not a regular file")])
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, "rb")
+
+
+def read_bytes(path: str | os.PathLike, *, limit: int, what: str) -> bytes:
+    """The bytes of a regular file named by the user (:func:`open_regular`), at most ``limit`` of
+    them (a 300 MB line must not fill memory); a clear :class:`InputError` on any failure.
+    ``what`` names the kind of file in the too-large message."""
+    with open_regular(path) as handle:
+        data = read_limited(handle, limit, str(path))
     if len(data) > limit:
-        raise InputError([Diagnostic(name, 0, 0, f"larger than {limit // (1024 * 1024)} MB: not {what}")])
+        raise InputError([Diagnostic(str(path), 0, 0, f"larger than {limit // (1024 * 1024)} MB: not {what}")])
     return data
+
+
+def read_limited(handle: BinaryIO, limit: int, name: str) -> bytes:
+    """Up to ``limit + 1`` bytes from ``handle`` (one more than allowed tells a file too large)."""
+    try:
+        return handle.read(limit + 1)
+    except OSError as exc:
+        raise InputError([Diagnostic(name, 0, 0, f"cannot read: {exc.strerror}")]) from None
 
 
 def read_text(path: str | os.PathLike) -> str:
