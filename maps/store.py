@@ -159,8 +159,10 @@ def _construct(node: yaml.Node, loader: _SafeLoader, file: str, budget: _Budget)
     try:
         return loader.construct_object(node, deep=True)
     except (ValueError, TypeError, OverflowError) as exc:  # an explicit tag on a value it cannot hold
-        raise InputError([Diagnostic(file, *_pos(node), f"malformed YAML: {node.value!r} cannot be read as "
-                                     f"{node.tag.rsplit(':', 1)[-1]} ({type(exc).__name__})")]) from None
+        text = node.value if len(node.value) <= 40 else f"{node.value[:20]}...{node.value[-8:]}"
+        length = "" if text is node.value else f", {len(node.value)} characters"
+        raise InputError([Diagnostic(file, *_pos(node), f"malformed YAML: {text!r} cannot be read as "
+                                     f"{node.tag.rsplit(':', 1)[-1]} ({type(exc).__name__}{length})")]) from None
 
 
 def _pos(node: yaml.Node) -> tuple[int, int]:
@@ -380,9 +382,26 @@ def write_yaml(path: str | os.PathLike, data: Any, *, header: str = "") -> None:
     write_text_atomic(path, comment + body)
 
 
+def finite(data: Any) -> Any:
+    """``data`` with every non-finite float (inf, nan) replaced by None, in mappings and lists."""
+    if isinstance(data, float):
+        return data if math.isfinite(data) else None
+    if isinstance(data, dict):
+        return {key: finite(value) for key, value in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [finite(value) for value in data]
+    return data
+
+
+def json_text(data: Any, **options: Any) -> str:
+    """Strict JSON (RFC 8259: no ``Infinity`` or ``NaN``, which other readers refuse): non-finite
+    numbers become ``null``, as the docs promise for every JSON file and line bearings writes."""
+    return json.dumps(finite(data), allow_nan=False, **options)
+
+
 def write_json(path: str | os.PathLike, data: Any) -> None:
-    """Atomically write JSON (reports), indented for people."""
-    write_text_atomic(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
+    """Atomically write strict JSON (reports, summaries), indented for people."""
+    write_text_atomic(path, json_text(data, indent=2, sort_keys=False) + "\n")
 
 
 def checksum(payload: bytes) -> str:

@@ -79,6 +79,10 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except BrokenPipeError:  # e.g. `bearings schema | head`
         return 0
+    except OSError as exc:  # the machine refused (a full disk, a vanished folder): one line, never a traceback
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"bearings {args.command}: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

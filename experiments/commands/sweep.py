@@ -19,10 +19,12 @@ from experiments.sweep.sweeper import (
     check_episodes,
     default_workers,
     executor_for,
+    prepare_results_folder,
     progress_stream,
     run_sweep,
 )
 from experiments.sweep.table import SUMMARY, TABLE, TornLineWarning, load_table
+from experiments.sweep.worker import run_number_problem
 from maps.store import write_json
 from missions.commands.common import EXIT_FAILURE, EXIT_OK, fail
 
@@ -120,8 +122,6 @@ def _episodes(args: argparse.Namespace) -> list[spec.Episode]:
     """The grid the options describe; :class:`SweepInputError` for any invalid option."""
     if not args.mission or args.output is None:
         raise spec.SweepInputError("give MISSION and -o RESULTS_DIR (or --summary RESULTS_DIR)")
-    if args.output.exists() and not args.output.is_dir():
-        raise spec.SweepInputError(f"-o {args.output}: not a folder")
     problem = _check_plot_options(args)
     if problem:
         raise spec.SweepInputError(problem)
@@ -129,14 +129,16 @@ def _episodes(args: argparse.Namespace) -> list[spec.Episode]:
         raise spec.SweepInputError("--retry-errors goes with --resume")
     if args.workers is not None and args.workers < 1:
         raise spec.SweepInputError("--workers must be at least 1")
-    for name, value in (("--timeout", args.timeout), ("--max-time", args.max_time)):
-        if value is not None and not value > 0:
-            raise spec.SweepInputError(f"{name} must be positive")
+    problem = run_number_problem(args.max_time, args.timeout)
+    if problem:
+        raise spec.SweepInputError(problem)
     mission = spec.absolute_if_file(args.mission)
     worlds = spec.parse_worlds(args.sim)
     seeds = spec.parse_seeds(args.seeds)
     sets = spec.parse_sets(args.sets)
-    return spec.grid(mission, worlds, seeds, sets, max_time_s=args.max_time)
+    episodes = spec.grid(mission, worlds, seeds, sets, max_time_s=args.max_time)
+    prepare_results_folder(args.output)
+    return episodes
 
 
 @contextlib.contextmanager

@@ -20,6 +20,8 @@ from typing import Any
 
 import yaml
 
+from maps.located import describe_value
+
 MAX_EPISODES = 100_000
 """The largest grid a sweep accepts (a typo like ``--seeds 0-9999999`` is an input error)."""
 
@@ -135,6 +137,8 @@ def parse_seeds(spec: str) -> list[int]:
     for part in spec.split(","):
         text = part.strip()
         match = re.fullmatch(r"(\d+)(?:-(\d+))?", text)
+        if match and max(len(n or "") for n in match.groups()) > len(str(MAX_SEED)):
+            raise SweepInputError(f"--seeds: seeds go from 0 to {MAX_SEED}, got {describe_value(text)}")
         if not match:
             raise SweepInputError(f"--seeds {spec}: expected N, A-B or a comma-separated list of them, got {text!r}")
         first = int(match.group(1))

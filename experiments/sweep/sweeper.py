@@ -116,6 +116,22 @@ def executor_for(workers: int | None, cluster: str | None) -> Iterator[Executor]
         yield executor
 
 
+def prepare_results_folder(folder: str | os.PathLike) -> None:
+    """Create a results folder (and its parents) and make sure files can be created in it;
+    :class:`SweepInputError` in one line when it cannot be used (a file in the way, ``/proc``, a
+    read-only disk). A file is created and removed rather than ``os.access`` asked: root passes
+    every permission check and still cannot write to a read-only file system."""
+    path = Path(folder)
+    if path.exists() and not path.is_dir():
+        raise SweepInputError(f"{path}: not a folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise SweepInputError(f"{path}: cannot write results there ({exc.strerror or exc})") from None
+
+
 def run_sweep(
     episodes: Sequence[Episode],
     *,
@@ -164,6 +180,11 @@ def run_sweep(
         except KeyboardInterrupt:
             rows = sorted([*done.values(), *space.recorded], key=lambda r: r["id"])
             raise SweepInterrupted(rows, len(unique)) from None
+        except OSError as exc:  # the results folder failed under the sweep (a full disk): stop, keep what is there
+            rows = sorted([*done.values(), *space.recorded], key=lambda r: r["id"])
+            recorded = {row["id"] for row in rows}
+            raise SweepError(f"cannot record results in {space.folder}: {exc.strerror or exc}", rows,
+                             [e.id for e in todo if e.id not in recorded]) from None
         finally:
             if owned:  # waits for the running tasks, which see the stop token and kill their episodes
                 executor.shutdown(wait=True, cancel_futures=True)
@@ -279,7 +300,7 @@ class _Workspace:
             self._scratch = tempfile.mkdtemp(prefix="bearings-sweep-")
             self.stop_path = Path(self._scratch) / "stop"
             return self
-        self.folder.mkdir(parents=True, exist_ok=True)
+        prepare_results_folder(self.folder)
         self._lock(self.folder)
         self.stop_path = self.folder / ".stop"
         self.existing = latest_by_id(read_rows(self.folder / TABLE))
@@ -298,8 +319,10 @@ class _Workspace:
         if self.journal is not None and self.folder is not None:
             self.journal.close()
             # the table holds what it held at the start (``existing``) and the rows appended since
-            # (``recorded``): sorted from memory, not read again
-            write_sorted(self.folder / TABLE, latest_by_id([*self.existing.values(), *self.recorded]).values())
+            # (``recorded``): sorted from memory, not read again; if that fails (a full disk) the
+            # journal keeps every row, unsorted
+            with contextlib.suppress(OSError):
+                write_sorted(self.folder / TABLE, latest_by_id([*self.existing.values(), *self.recorded]).values())
         self._unlock()
 
     def record(self, episode: Episode, result: EpisodeResult) -> Row:
