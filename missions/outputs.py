@@ -90,10 +90,12 @@ def prepare_written_files(mission: MissionSpec, announce: Callable[[str], None])
         return
     written = written_files([*mission.sense, mission.tree], mission.registry, folders)
     base = folders.base
-    inside = any(base in path.parents for _, _, path in written)
-    if inside and not base.exists() and output_problem(base) is None:
-        base.mkdir(parents=True)
-        announce(f"created the output folder {base}")
+    if any(base in path.parents for _, _, path in written) and not base.exists():
+        try:
+            base.mkdir(parents=True)
+            announce(f"created the output folder {base}")
+        except OSError:
+            pass  # each file's own check below says why it cannot be written
     problems = []
     for spec, port, path in written:
         problem = output_problem(path)

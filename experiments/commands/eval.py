@@ -18,7 +18,8 @@ from typing import Any
 
 from experiments.eval import AREAS, EvalOptions
 from experiments.sweep import SweepError, SweepInputError, SweepInterrupted, executor_for
-from experiments.sweep.sweeper import prepare_results_folder, progress_stream
+from experiments.sweep.lifeline import lifeline
+from experiments.sweep.sweeper import cap_workers, prepare_results_folder, progress_stream
 from experiments.sweep.table import TABLE
 from experiments.sweep.worker import run_number_problem
 from maps.store import InputError, json_text
@@ -103,9 +104,10 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:  # SweepInputError too
         return fail("eval", str(exc))
     with contextlib.ExitStack() as stack:
+        stack.enter_context(lifeline("eval"))  # whatever ends the evaluation, its processes and folders end with it
         folder = args.output or Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="bearings-eval-")))
         try:
-            executor = stack.enter_context(executor_for(args.workers, args.cluster))
+            executor = stack.enter_context(executor_for(cap_workers(args.workers, "eval"), args.cluster))
             options = EvalOptions(args.world, list(range(args.seeds)), executor, folder, args.timeout,
                                   args.max_time, progress_stream(args.progress), extra, (world, settings))
             figures = module.run(options, resume=args.resume)

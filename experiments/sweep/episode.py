@@ -40,8 +40,10 @@ class Episode:
     """One ``bearings run``: ``mission`` (file or shipped name), ``world`` (shipped name or file,
     ``"empty"`` for the empty plane), ``seed``, ``inputs`` (``--set name=value``; values are YAML
     text as on the command line, or plain scalars), ``max_time_s`` (the run's ``--max-time``,
-    simulated seconds; None: the mission's own limit) and ``start`` (the run's ``--start``: a
-    start pose ``x,y,theta`` or a named pose of the world; None: the world's start)."""
+    simulated seconds; None: the mission's own limit), ``start`` (the run's ``--start``: a
+    start pose ``x,y,theta`` or a named pose of the world; None: the world's start) and
+    ``output_dir`` (the run's ``--output-dir``, where the files the mission writes go; where the
+    episode writes is not what it is, so it is not part of the id)."""
 
     mission: str
     world: str = "empty"
@@ -49,6 +51,7 @@ class Episode:
     inputs: Mapping[str, Any] = field(default_factory=dict)
     max_time_s: float | None = None
     start: str | None = None
+    output_dir: str | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inputs", {str(k): v for k, v in sorted(dict(self.inputs).items())})
@@ -99,6 +102,8 @@ class Episode:
             argv += ["--max-time", repr(float(self.max_time_s))]
         if self.start is not None:
             argv.append(f"--start={self.start}")  # '=': a pose may start with a minus sign
+        if self.output_dir is not None:
+            argv += ["--output-dir", str(self.output_dir)]
         return argv
 
 

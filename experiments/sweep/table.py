@@ -32,6 +32,7 @@ TABLE = "results.jsonl"
 REPORTS = "reports"
 LOGS = "logs"
 SUMMARY = "summary.json"
+OUTPUTS = "outputs"  # a sweep's runs write their files in outputs/<id>/ (their --output-dir)
 
 WALL_TIME_KEYS = frozenset({"wall_time_s", "elapsed_s"})
 """Row keys that measure wall-clock time: the only figures that differ between two runs of the same

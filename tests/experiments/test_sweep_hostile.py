@@ -91,3 +91,35 @@ def test_a_disk_that_fills_up_under_a_sweep_stops_it_with_the_rows_so_far(tmp_pa
     assert "No space left on device" in str(info.value) and len(info.value.rows) == 1
     assert len(info.value.lost) == 2
     assert len(read_rows(tmp_path / "out" / "results.jsonl")) == 1  # the one row the disk took
+
+
+def test_workers_are_capped_at_what_the_machine_has(capsys, monkeypatch):
+    from experiments.sweep import sweeper
+
+    cores = sweeper.default_workers()
+    monkeypatch.setattr(sweeper, "_available_memory", lambda: 64 * sweeper.WORKER_BYTES)
+    assert sweeper.cap_workers(cores, "sweep") == cores and capsys.readouterr().err == ""
+    assert sweeper.cap_workers(10_000, "sweep") == cores
+    assert capsys.readouterr().err == f"bearings sweep: --workers 10000 capped at {cores} (the cores this process " \
+                                      "may use)\n"
+    monkeypatch.setattr(sweeper, "_available_memory", lambda: sweeper.WORKER_BYTES // 2)
+    assert sweeper.cap_workers(10_000, "eval") == 1
+    assert "capped at 1 (the free memory, 0.1 GiB)" in capsys.readouterr().err
+
+
+WRITER = """\
+sense: [Perceive]
+tree:
+  LearnRoute: {path: route.ltmap, child: Stop}
+"""
+
+
+def test_each_run_of_a_sweep_writes_its_files_in_a_folder_of_its_own(tmp_path):
+    mission = tmp_path / "writer.yaml"
+    mission.write_text(WRITER)
+    assert main(["sweep", str(mission), "--seeds", "0-1", "--workers", "1", "-o", str(tmp_path / "out")]) == 0
+    rows = read_rows(tmp_path / "out" / "results.jsonl")
+    assert [row["status"] for row in rows] == ["SUCCESS", "SUCCESS"]
+    for row in rows:
+        assert (tmp_path / "out" / "outputs" / row["id"] / "route.ltmap").is_file()
+    assert not (tmp_path / "route.ltmap").exists()
