@@ -107,9 +107,14 @@ def _measure(quick: bool) -> dict:
 
 
 _PEAK_RSS = """
-import json, resource, sys, tempfile
+import json, sys, tempfile
 from drivers.sim.simulation import Simulation
 from maps.store import dump_yaml, load_yaml
+
+def peak():  # this process's own high-water mark (getrusage's can start at the parent's, from the fork)
+    status = open("/proc/self/status").read().split("VmHWM:")[1]
+    return int(status.split()[0]) * 1024
+
 world = dict(load_yaml(sys.argv[1]))
 camera = {"name": "measured", "kind": sys.argv[2], "mount": "base", "pose": {"z": 0.9},
           "model": json.loads(sys.argv[3])}
@@ -120,9 +125,9 @@ with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as handle:
     handle.write(dump_yaml(world))
 sim = Simulation.load(handle.name, seed=0)
 sim.snapshot(sim.world.start, "warm")  # textures and the process's own growth, before the measurement
-before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+before = peak()
 sim.snapshot(sim.world.start, "measured")
-print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) * 1024)
+print(peak() - before)
 """
 
 
