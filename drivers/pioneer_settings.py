@@ -60,6 +60,10 @@ class PioneerSettings(BaseModel):
     max_turn_rate: float | None = quantity(None, "turn rate limit (default: the model's)", "deg/s",
                                            ge=1.0, le=500.0)
     sonar: bool = Field(True, description="enable the sonar rings")
+    guard: bool = Field(True, description="while a session is open, a guard process holds the link and stops "
+                        "the robot (STOP, ENABLE 0, CLOSE) if this process dies without closing it (a crash, "
+                        "kill -9, a plugin's os._exit): within milliseconds instead of the firmware watchdog's "
+                        "seconds (drivers/link_guard.py)")
     request_config: bool = Field(True, description="ask for the config packet when connecting (limits, "
                                  "firmware watchdog, serial number, whether HOSTBAUD is allowed; shown by "
                                  "'bearings doctor')")

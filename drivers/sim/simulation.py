@@ -58,6 +58,12 @@ class SimClock:
         self._now = self._ticks * period
 
 
+WATCHDOG_S = 2.0
+"""The simulated base stops when no command arrives for this long, as a Pioneer's firmware does
+(its config packet's Watchdog, 2000 ms; docs/protocols.md): a mission that leaves the base to run
+on without commands stops in the simulator as it would on the robot."""
+
+
 class SimBase:
     """The :class:`~drivers.interfaces.Base` of the simulated robot."""
 
@@ -67,6 +73,7 @@ class SimBase:
 
     def drive(self, v: float, w: float) -> None:
         self.commands.append((self._sim.time, float(v), float(w)))
+        self._sim.last_command = self._sim.time
         self._sim.drive.command(v, w)
 
     def stop(self) -> None:
@@ -115,6 +122,7 @@ class Simulation:
         streams = np.random.SeedSequence([seed, 0xBEA], pool_size=4).spawn(1 + len(self.world.cameras))
         self.scene = Scene(self.world)
         self.time = 0.0
+        self.last_command = 0.0  # when the base last heard a drive command (the watchdog's clock)
         self.stalled = False
         self.collisions = 0
         self._in_contact = False
@@ -155,9 +163,12 @@ class Simulation:
 
         A step that would bring the robot's disc into a wall, box or pillar (closer than it was)
         does not happen: the base stops there, its wheels and odometry included, and
-        :meth:`SimBase.stalled` is True until a command moves it away.
+        :meth:`SimBase.stalled` is True until a command moves it away. A base that has heard no
+        command for :data:`WATCHDOG_S` stops, as the robot's firmware stops it.
         """
         drive = self.drive
+        if self.time - self.last_command >= WATCHDOG_S - 1e-9 and drive.target != (0.0, 0.0):
+            drive.command(0.0, 0.0)  # the firmware's watchdog: no command for WATCHDOG_S, the base stops
         before_true, before_odom = drive.true_pose.copy(), drive.odom_pose.copy()
         drive.step(dt, blocked=False)
         radius = self.world.robot_radius
