@@ -97,10 +97,10 @@ def emit(command: str, text: str, output: str | os.PathLike | None, inputs: Iter
     if output is None:
         sys.stdout.write(text)
         return EXIT_OK
-    problem = output_problem(output) or _input_problem(output, inputs)
+    problem = output_problem(output) or same_as_input(output, inputs)
     if problem:
         return fail(command, f"cannot write {output}: {problem}")
-    replacing = os.path.exists(output)
+    replacing = os.path.isfile(output)
     try:
         write_text_atomic(output, text)
     except OSError as exc:
@@ -112,8 +112,9 @@ def emit(command: str, text: str, output: str | os.PathLike | None, inputs: Iter
     return EXIT_OK
 
 
-def _input_problem(output: str | os.PathLike, inputs: Iterable[str | os.PathLike]) -> str | None:
-    """Why ``output`` must not be written: it is (a link to) one of the command's input files."""
+def same_as_input(output: str | os.PathLike, inputs: Iterable[str | os.PathLike]) -> str | None:
+    """Why ``output`` must not be written: it is (a link to) one of the command's input files
+    (``import t.xml -o t.xml``, ``calibrate a.png -o a.png``), else None."""
     for given in inputs:
         with contextlib.suppress(OSError):
             if os.path.exists(output) and os.path.samefile(output, given):

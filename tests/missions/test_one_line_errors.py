@@ -126,3 +126,21 @@ def test_json_is_strict_non_finite_numbers_are_null(tmp_path):
     write_json(tmp_path / "x.json", data)
     text = (tmp_path / "x.json").read_text()
     assert "Infinity" not in text and "NaN" not in text and json.loads(text)["d"] == 1e308
+
+
+def test_calibrate_never_writes_over_an_image_it_reads(tmp_path, capsys):
+    names = []
+    for k in range(3):
+        names.append(str(tmp_path / f"{k}.png"))
+        cv2.imwrite(names[-1], np.zeros((60, 80), np.uint8))
+    before = Path(names[0]).read_bytes()
+    err = _one_line(capsys, main(["calibrate", *names, "--board", "9x6", "--square", "0.025", "-o", names[0]]), 2)
+    assert f"cannot write {names[0]}: it is the input file {names[0]}" in err
+    assert Path(names[0]).read_bytes() == before
+
+
+def test_a_snapshot_says_when_it_replaced_a_file(tmp_path, capsys):
+    out = tmp_path / "view.png"
+    for replaced in (False, True):
+        assert main(["sim", "snapshot", "--world", "lab", "--pose", "1.5,1.5,0", "-o", str(out)]) == 0
+        assert ("replaced the previous file" in capsys.readouterr().out) == replaced
