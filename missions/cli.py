@@ -18,6 +18,7 @@ import sys
 from importlib.metadata import EntryPoint, entry_points
 
 from missions.commands import COMMANDS, ENTRY_POINT_GROUP
+from missions.threads import pin_thread_pools
 
 EPILOG = """exit codes: 0 mission SUCCESS / command done, 1 mission FAILURE, 2 invalid input,
 130/143 interrupted by SIGINT/SIGTERM.
@@ -67,6 +68,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    pin_thread_pools()  # before any command module imports numpy (missions/threads.py says why)
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
