@@ -75,7 +75,9 @@ class InputPort(Generic[T]):
 
     ``unit`` is the unit a mission writes the value in; ``choices`` restrict a ``str``;
     ``minimum``/``maximum`` bound numbers; ``literal_only`` ports configure the node and cannot
-    change while it runs (they take no reference).
+    change while it runs (they take no reference). ``camera`` marks a text port that names the
+    camera whose frames the node reads: a mission without ``cameras:`` grabs the cameras its nodes
+    name this way and no other (:mod:`missions.camera_use`).
 
     The port is generic in its value type, so ``node.get_input(SPEED)`` is a ``float`` to mypy
     (``InputPort("speed", float, ...)`` infers ``InputPort[float]``). A union type cannot be
@@ -91,6 +93,7 @@ class InputPort(Generic[T]):
     minimum: float | None = None
     maximum: float | None = None
     literal_only: bool = False
+    camera: bool = False
 
     @property
     def required(self) -> bool:

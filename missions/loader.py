@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +26,7 @@ from behaviours.ports import InputPort
 from behaviours.registry import Registry
 from maps.located import diagnose, suggest
 from maps.store import Diagnostic, InputError, Mark, YamlList, YamlMap, load_yaml, mark_of
+from missions.camera_use import cameras_read
 from missions.dataflow import check_dataflow
 from missions.inputs import IDENT, bind, declaration, substitute
 from missions.language import MissionSpec, NodeSpec
@@ -262,6 +263,8 @@ def load_mission(
     problems = check_dataflow(mission)
     if problems:
         raise InputError(problems)
+    if cameras is None:  # grab what the nodes read, no more (missions/camera_use.py)
+        mission = replace(mission, cameras=cameras_read(mission))
     return mission
 
 
