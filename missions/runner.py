@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import sys
 import time
 import traceback
 from collections.abc import Callable, Mapping, Sequence
@@ -56,6 +55,7 @@ from drivers.keyboard import TerminalKeys
 from maps.store import write_json
 from missions.builder import build_root
 from missions.clocks import WallClock
+from missions.images import DEFAULT_RATE_HZ
 from missions.language import MissionSpec
 from missions.recording import Recorder
 from missions.safety import Interrupted, SafetyMonitor, exit_code
@@ -78,7 +78,7 @@ class RunOptions:
     overrun_s: float | None = None  # tick watchdog limit; None: the mission's on a robot, none in simulation
     report_path: Path | None = None
     save_path: Path | None = None
-    progress: bool = False
+    image_rate_hz: float | None = DEFAULT_RATE_HZ  # camera images per second in the recording; None or 0: every frame
     seed: int = 0
     debug: bool = False  # print the traceback of an exception in the tree
 
@@ -176,7 +176,7 @@ class Runner:
         if self.options.save_path is not None:
             self._recorder = Recorder(self.options.save_path, mission=self.mission.name,
                                       recording_id=f"{self.mission.name}-seed{self.options.seed}",
-                                      timeline=self.clock.timeline)
+                                      timeline=self.clock.timeline, image_rate_hz=self.options.image_rate_hz)
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
         # hand every node the clock and the drivers (the keyboard as an opener: a terminal is taken only if used)
@@ -185,7 +185,6 @@ class Runner:
                          or callable(getattr(node, "log_rerun", None))]
 
     def _loop(self) -> tuple[str, str]:
-        last_progress = 0.0
         while True:
             stop = self.monitor.stopped_reason
             if stop is not None:
@@ -202,9 +201,6 @@ class Runner:
                 return "FAILURE", self.monitor.fault
             if self.on_tick is not None:
                 self.on_tick(self)
-            if self.options.progress and time.monotonic() - last_progress > 0.2:
-                last_progress = time.monotonic()
-                self._print_progress(now)
             if self.root.status in (Status.SUCCESS, Status.FAILURE):
                 return self.root.status.value, self._outcome_reason()
             self.clock.next_tick(self.period)
@@ -220,8 +216,6 @@ class Runner:
             with contextlib.suppress(Exception):  # the run's outcome matters more than the file
                 self._recorder.log_stop(time_s=self.clock.now(), tick=self.ticks)
                 self._recorder.close()
-        if self.options.progress:
-            sys.stderr.write("\n")
 
     def _result(self, status: str, reason: str) -> RunResult:
         result = RunResult(status, reason, self.ticks, self.clock.now(), signum=self.monitor.signum)
@@ -260,7 +254,8 @@ class Runner:
         if self._recorder is not None:
             self._recorder.log_tick(time_s=self.clock.now(), tick=self.ticks + 1, root=self.root,
                                     odometry=self._get("/robot/odometry"), command=self.last_command,
-                                    observers=self.observers, nodes=self._drawers)
+                                    observers=self.observers, nodes=self._drawers,
+                                    frames=self._get("/perception/frames"))
 
     # -- helpers ---------------------------------------------------------------------------------
     def _get(self, key: str) -> Any:
@@ -293,13 +288,6 @@ class Runner:
             detail = f": {node.feedback_message}" if node.feedback_message else ""
             return f"{node.name} failed{detail}"
         return "mission tree failed"
-
-    def _print_progress(self, now: float) -> None:
-        tip = self.task.tip()
-        active = "" if tip is None else tip.name + (f": {tip.feedback_message}" if tip.feedback_message else "")
-        line = f"[{self.mission.name}] t={now:7.1f} s  tick {self.ticks:6d}  {active}"
-        sys.stderr.write("\r" + line[:110].ljust(110))
-        sys.stderr.flush()
 
     def _report(self, result: RunResult) -> dict[str, Any]:
         mission = self.mission

@@ -293,15 +293,13 @@ class Simulation:
     # ----------------------------------------------------------------------------------------
     # Visualisation
 
-    def log_rerun(self, rec: Any, *, image_every: int | None = None) -> None:
+    def log_rerun(self, rec: Any) -> None:
         """Log this tick to rerun (``rec``: the rerun module or a RecordingStream).
 
         Once: the world from above (walls, pillars, landmarks, named poses, static). Every call:
         the true and odometry poses, heading and pan-tilt view direction. Every 20th call: the
-        trajectories. Every ``image_every``-th call (default 10): the latest frame of each camera.
+        trajectories. Camera images are the recorder's (the frames the mission grabbed).
         """
-        if image_every is not None:
-            self._rerun.image_every = max(1, int(image_every))
         self._rerun.log(self, rec)
 
 

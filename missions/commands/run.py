@@ -8,12 +8,15 @@ from pathlib import Path
 from typing import Any
 
 from behaviours.clock import TickClock
-from drivers.interfaces import Robot
+from drivers.interfaces import KeyboardOpener, Robot
+from drivers.keyboard import TerminalKeys
 from maps.located import validate
 from maps.store import Diagnostic, InputError, output_problem, write_json
-from missions.clocks import Paced, WallClock
+from missions.clocks import Paced, WallClock, paced_when_operated
 from missions.commands.common import add_mission_options, load_from_args, parse_pose, print_input_error
+from missions.images import DEFAULT_RATE_HZ
 from missions.model import RunArguments
+from missions.progress import progress_for
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
 from perception.geometry import Pose2D
@@ -22,7 +25,8 @@ DESCRIPTION = """Run a mission until its tree ends in SUCCESS or FAILURE.
 
 Without --robot the mission runs in the built-in simulator (--sim WORLD picks a shipped world by
 name or a world file; the default is an empty plane), as fast as the machine allows unless
---realtime is given. The same seed gives the same run, bit for bit.
+--realtime is given or an operator drives by keys (real time from when a key node first runs).
+The same seed gives the same run, bit for bit.
 
 Whatever happens (the tree ends, a behaviour raises or blocks, Ctrl-C, SIGTERM, --max-time), the
 base and the pan-tilt unit are commanded to stop before the drivers close, and --report is
@@ -49,12 +53,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="write the run report (JSON) here; a missing folder is created")
     parser.add_argument("--save", type=Path, metavar="F.rrd",
                         help="record the run for the rerun viewer; a missing folder is created")
+    parser.add_argument("--image-rate", type=float, metavar="HZ", default=DEFAULT_RATE_HZ,
+                        help=f"camera images per second and camera in the --save recording, JPEG-encoded "
+                             f"(default {DEFAULT_RATE_HZ:g}; 0: every frame grabbed)")
     parser.add_argument("--max-time", type=float, metavar="S", help="FAILURE after S seconds (sim or wall time)")
     parser.add_argument("--rate", type=float, metavar="HZ", help="tick rate (default: the mission's, else 10)")
     parser.add_argument("--overrun", type=float, metavar="S",
                         help="how far a tick may overrun its period before the watchdog stops the base")
     parser.add_argument("--realtime", action="store_true", help="pace the simulator at wall-clock speed")
     parser.add_argument("--quiet", action="store_true", help="no progress line")
+    parser.add_argument("--progress", action="store_true",
+                        help="print progress even when stderr is not a terminal: a line every few seconds")
     parser.add_argument("--debug", action="store_true", help="print the traceback when a behaviour raises")
     add_mission_options(parser)
     parser.set_defaults(func=run)
@@ -87,11 +96,19 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
                                  f"{', '.join(robot.cameras) or 'none'})")]))
     options = RunOptions(
         rate_hz=numbers.rate, max_time_s=numbers.max_time, overrun_s=numbers.overrun, report_path=args.report,
-        save_path=args.save, progress=not args.quiet and sys.stderr.isatty(), seed=numbers.seed, debug=args.debug,
+        save_path=args.save, image_rate_hz=numbers.image_rate, seed=numbers.seed, debug=args.debug,
     )  # fmt: skip
-    if args.realtime and simulation is not None:
-        clock = Paced(clock)
-    result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else []).run()
+    keyboard: KeyboardOpener = TerminalKeys
+    if simulation is not None:  # real time when asked, or from when an operator takes the keyboard
+        clock = Paced(clock, engaged=args.realtime)
+        keyboard = paced_when_operated(TerminalKeys, clock, said=lambda line: print(line, file=sys.stderr))
+    progress = progress_for(mission.name, sys.stderr, asked=args.progress, quiet=args.quiet)
+    try:
+        result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
+                        on_tick=progress, keyboard=keyboard).run()
+    finally:
+        if progress is not None:
+            progress.close()
     clock_name = "sim" if simulation is not None else "wall"
     print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock_name} time, {result.ticks} ticks "
           f"({result.reason})")
@@ -108,7 +125,8 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
 
 
 def _numbers(args: argparse.Namespace) -> RunArguments:
-    given = {"--rate": args.rate, "--max-time": args.max_time, "--overrun": args.overrun, "--seed": args.seed}
+    given = {"--rate": args.rate, "--max-time": args.max_time, "--overrun": args.overrun, "--seed": args.seed,
+             "--image-rate": args.image_rate}
     return validate(RunArguments, {k: v for k, v in given.items() if v is not None}, file="command line")
 
 

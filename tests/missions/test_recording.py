@@ -52,8 +52,8 @@ def test_every_drawing_becomes_its_archetype():
     recorder.log_node(_Node())
     kinds = {entity: kind for entity, kind, _ in fake.logged}
     assert kinds == {"figures/ltmap/search/scans": "Scalars", "a/points2d": "Points2D", "a/points3d": "Points3D",
-                     "a/lines": "LineStrips2D", "a/arrows": "Arrows2D", "a/picture": "Image", "a/events": "TextLog",
-                     "a/plot": "Scalars"}
+                     "a/lines": "LineStrips2D", "a/arrows": "Arrows2D", "a/picture": "EncodedImage",
+                     "a/events": "TextLog", "a/plot": "Scalars"}
     labels = next(kwargs["labels"] for entity, _, kwargs in fake.logged if entity == "a/points3d")
     assert labels == ["x", "y", "z"]
 
