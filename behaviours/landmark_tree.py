@@ -15,6 +15,7 @@ reached while following a pruned map with the place it was taught.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Iterator
 from typing import Any
 
@@ -86,7 +87,8 @@ class LoadMap(BearingsBehaviour):
 
     def figures(self) -> Iterator[Figure]:
         if self.summary is not None:
-            yield from section("ltmap", {"map_file": self.get_input(self.PATH), **summary_section(self.summary)})
+            yield from section("ltmap", {"map_file": os.path.abspath(self.get_input(self.PATH)),
+                                         **summary_section(self.summary)})
 
 
 @register

@@ -401,7 +401,7 @@ class ViewframeSwitch(BearingsBehaviour):
 
     def figures(self) -> Iterator[Figure]:
         rules = [r["rule"] for r in self.reached]
-        yield Figure("ltmap", "switches", len(self.reached))
+        yield Figure("ltmap", "switches", len(self.reached), headline=True)  # viewframes reached on the way
         yield Figure("ltmap", "switches_by_flip", rules.count("flip"))
         yield Figure("ltmap", "reached", list(self.reached))
 

@@ -59,6 +59,7 @@ from missions.images import DEFAULT_RATE_HZ
 from missions.language import MissionSpec
 from missions.recording import Recorder
 from missions.safety import Interrupted, SafetyMonitor, exit_code
+from missions.summary import declared_headline
 
 
 class RunObserver(Protocol):
@@ -264,7 +265,7 @@ class Runner:
         except KeyError:
             return None
 
-    def _node_sections(self) -> dict[str, dict[str, Any]]:
+    def _node_sections(self) -> Sections:
         """What the tree's nodes add to the report (a node that fails to say is noted, not fatal)."""
         gathered = Sections()
         for node in self.root.iterate():
@@ -276,7 +277,7 @@ class Runner:
                         gathered.add(section(name, values))
             except Exception as exc:  # noqa: BLE001 - the report must be written whatever a node does
                 gathered.sections.setdefault("report_errors", {})[node.name] = describe_exception(exc)
-        return gathered.sections
+        return gathered
 
     def _outcome_reason(self) -> str:
         if self.root.status == Status.SUCCESS:
@@ -307,12 +308,14 @@ class Runner:
             report["sim_time_s"] = round(result.time_s, 6)
         for observer in self.observers:
             report.update(observer.report_sections(mission.evaluation))
-        for name, values in self._node_sections().items():
+        nodes = self._node_sections()
+        for name, values in nodes.sections.items():
             report.setdefault(name, {}).update(values)
         for device in (self.robot.base, self.robot.ptu):
             sections = getattr(device, "report_sections", None)
             if callable(sections):
                 report.update(sections())
+        report["headline"] = declared_headline([*self.observers, self.robot.base, self.robot.ptu], nodes.headline)
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}

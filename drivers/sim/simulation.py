@@ -192,6 +192,9 @@ class Simulation:
     # ----------------------------------------------------------------------------------------
     # Ground truth (evaluation only)
 
+    HEADLINE = ("ground_truth.goal_error_m", "ground_truth.path_error_m", "ground_truth.trajectory_length_m")
+    """The ground-truth figures the end-of-run line shows (besides collisions: ``missions/summary.py``)."""
+
     def report_sections(self, evaluation: Mapping[str, Any]) -> dict[str, Any]:
         """What a run report gets from the simulator: ``ground_truth`` against the mission's
         ``evaluation`` references (``goal``, ``reference_path``, ``frame``)."""

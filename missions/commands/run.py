@@ -19,6 +19,7 @@ from missions.model import RunArguments
 from missions.progress import progress_for
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
+from missions.summary import summary_line
 from perception.geometry import Pose2D
 
 DESCRIPTION = """Run a mission until its tree ends in SUCCESS or FAILURE.
@@ -112,11 +113,9 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
     clock_name = "sim" if simulation is not None else "wall"
     print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock_name} time, {result.ticks} ticks "
           f"({result.reason})")
-    gt = result.report.get("ground_truth")
-    if gt:
-        figures = ", ".join(f"{k} {gt[k]:.3f}" for k in ("trajectory_length_m", "goal_error_m", "path_error_m")
-                            if k in gt)
-        print(f"ground truth: {figures}")
+    summary = summary_line(result.report)
+    if summary:
+        print(summary)
     if args.report:
         print(f"report: {args.report}")
     if args.save:
