@@ -225,6 +225,7 @@ def load_mission(
     overrides: Mapping[str, str] | None = None,
     search_path: Iterable[str | os.PathLike] = (),
     registry: Registry | None = None,
+    require_inputs: bool = False,
 ) -> MissionSpec:
     """Load and validate a mission file; raise :class:`InputError` listing every problem found.
 
@@ -232,7 +233,10 @@ def load_mission(
     inputs' types. ``search_path`` is where ``include:`` looks after the including file's folder
     (then ``$BEARINGS_PATH``, then the shipped mission library). ``registry`` is the set of node
     types the mission may use before its own plugins (default: built-ins and entry points); the
-    mission's plugins are added to a child of it, never to it.
+    mission's plugins are added to a child of it, never to it. A required input (declared without
+    a default) that ``overrides`` does not give is a problem with ``require_inputs`` (a mission to
+    run: ``bearings run`` says so before anything moves); without it the mission is checked with
+    the input :class:`~missions.inputs.Unbound` (``bearings validate``, ``show``).
     """
     env = [Path(p) for p in os.environ.get(PATH_ENV, "").split(os.pathsep) if p]
     loader = _Loader(search_path=[Path(p).resolve() for p in [*search_path, *env]],
@@ -243,7 +247,7 @@ def load_mission(
         raise InputError(loader.diagnostics)
     declared = loader.inputs(doc)
     values, problems = bind(declared, dict(overrides or {}), file="--set", marks={}, default_mark=Mark(0, 0),
-                            texts=True)
+                            texts=True, require=require_inputs)
     loader.diagnostics.extend(problems)
     scope = Scope(str(file_path), values, chain=(file_path.resolve(),))
     sense = _sense(loader, doc, scope)

@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             numbers = _numbers(args)
             _prepare_outputs(args)
-            mission = load_from_args(args.mission, args)
+            mission = load_from_args(args.mission, args, to_run=True)
             simulation, robot, clock = _open(args, numbers.seed)
         except InputError as exc:
             return print_input_error(exc)
