@@ -242,6 +242,8 @@ def load_mission(
     loader = _Loader(search_path=[Path(p).resolve() for p in [*search_path, *env]],
                      registry=(registry or Registry.default()).child())
     file_path = resolve_mission_path(path)
+    if not file_path.exists():
+        raise InputError([_not_found(file_path)])
     doc = loader.document(file_path)
     if doc is None:
         raise InputError(loader.diagnostics)
@@ -278,6 +280,15 @@ def resolve_mission_path(path: str | os.PathLike) -> Path:
     if not candidate.exists() and not candidate.suffix and (LIBRARY / f"{candidate}.yaml").is_file():
         return LIBRARY / f"{candidate}.yaml"
     return candidate
+
+
+def _not_found(path: Path) -> Diagnostic:
+    """A mission that is neither a file nor a shipped name: the shipped name it is most like, if any."""
+    shipped = sorted(p.stem for p in LIBRARY.glob("*.yaml"))
+    if path.suffix or len(path.parts) > 1:
+        return Diagnostic(str(path), 0, 0, "no such file")
+    return Diagnostic(str(path), 0, 0, f"no such file, and no shipped mission of that name{suggest(path.name, shipped)}"
+                      f" (bearings missions lists them: {', '.join(shipped)})")
 
 
 def _sense(loader: _Loader, doc: _Document, scope: Scope) -> tuple[NodeSpec, ...]:

@@ -254,6 +254,9 @@ class Simulation:
             "trajectory": _decimate(true, max_points=2000),
             "stops": _stops(true),
             "landmarks": [[int(lm.id), lm.x, lm.y, lm.z] for lm in self.world.landmarks],
+            # where odometry believed the robot was, (t, x, y) in the world (odometry starts at the true start)
+            "odometry_trajectory": _decimate(np.column_stack([np.asarray(self.truth.odometry)[:, 0],
+                                                              self.odometry_trajectory_in_world()]), max_points=2000),
         }
         if goal is not None:
             report["goal_error_m"] = float(math.hypot(xy[-1, 0] - goal[0], xy[-1, 1] - goal[1]))

@@ -37,3 +37,15 @@ def test_validate_passes_and_run_exits_2_before_anything_moves(write_mission, tm
     assert main(["run", str(path), "--quiet", "--report", str(report)]) == 2
     assert not report.exists()
     assert "input 'd' is required" in capsys.readouterr().err
+
+
+def test_a_misspelt_shipped_mission_gets_a_did_you_mean(capsys):
+    assert main(["run", "sqare", "--quiet"]) == 2
+    assert "sqare: no such file, and no shipped mission of that name; did you mean 'square'?" in capsys.readouterr().err
+
+
+def test_bearings_missions_lists_the_shipped_missions_with_their_required_inputs(capsys):
+    assert main(["missions"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("explore: Explore with the stereo pair") and "square: Drive a square" in out
+    assert "inputs: target (required), roadmap, seed" in out
