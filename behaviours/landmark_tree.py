@@ -1,6 +1,6 @@
 """The LT-map on the blackboard: load it from a file, prune it to a memory budget.
 
-The map of a taught route (:class:`maps.ltmap.tree.LandmarkTree`, DESIGN.md algorithm 1) travels
+The map of a taught route (:class:`maps.ltmap.tree.LandmarkTree`, docs/design.md method 1) travels
 between nodes on ``/map/ltmap``: ``LearnRoute`` (:mod:`behaviours.teach`) or :class:`LoadMap`
 write it, :class:`PruneMap` shrinks it, the route-following nodes (:mod:`behaviours.route`,
 :mod:`behaviours.search`) read it. The file path is a literal port, so missions pass it as an

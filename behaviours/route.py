@@ -1,4 +1,4 @@
-"""Route following on an LT-map: home to one viewframe after another (DESIGN.md, algorithm 1).
+"""Route following on an LT-map: home to one viewframe after another (docs/design.md, method 1).
 
 Three nodes share the work, composed in a mission (``follow_route.yaml``) with the control
 nodes rather than in one behaviour; what they compute about a viewframe is perception's
