@@ -150,7 +150,14 @@ class PruneMap(BearingsBehaviour):
                         "memory_fraction": round(after / before, 4) if before else 1.0,
                         "viewframe_source": source.tolist()}
         self.feedback_message = f"{before} -> {after} bytes, {pruned.viewframe_count} viewframes"
+        if budget is not None and before:
+            # whole tree levels are cut: the map lands on the nearest cut under the budget, often well under it
+            self.section["memory_fraction_asked"] = round(budget / before, 4)
+            self.feedback_message += (f" ({after / before:.1%} of the map for {budget / before:.1%} asked: pruning "
+                                      "cuts whole tree levels, this is the nearest cut under the budget)")
         return Status.SUCCESS
 
     def figures(self) -> Iterator[Figure]:
-        yield from section("ltmap", self.section)
+        asked = "memory_fraction_asked" in self.section  # a budget was given: say what it gave
+        shown = ("memory_fraction_asked", "memory_fraction") if asked else ()
+        yield from section("ltmap", self.section, headline=shown)

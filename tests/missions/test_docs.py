@@ -7,6 +7,7 @@ import contextlib
 import glob
 import io
 import re
+import textwrap
 from pathlib import Path
 
 import pytest
@@ -193,3 +194,10 @@ def test_the_readme_examples_run_as_written(heading, tmp_path, monkeypatch, caps
         shortened = "--max-time" in words and "--max-time" not in example.text
         assert code == 0 or (code == 1 and shortened), f"{example.where}: bearings {example.text}: exit {code}\n" \
                                                        f"{capsys.readouterr().err[-2000:]}"
+
+
+def test_the_harness_docstring_example_runs_as_written():
+    import behaviours.testing
+
+    example = behaviours.testing.__doc__.split("Example::")[1].split("Like the runner")[0]
+    exec(compile(textwrap.dedent(example), "behaviours/testing.py", "exec"), {})  # noqa: S102
