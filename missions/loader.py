@@ -252,11 +252,13 @@ def load_mission(
                             texts=True, require=require_inputs)
     loader.diagnostics.extend(problems)
     scope = Scope(str(file_path), values, chain=(file_path.resolve(),))
+    before_nodes = len(loader.diagnostics)
     sense = _sense(loader, doc, scope)
     tree = loader.reader.node(doc.data["tree"], doc.data.value_mark_of("tree"), scope, 0)
+    nodes_whole = tree is not None and len(loader.diagnostics) == before_nodes
     evaluation = _evaluation(loader, doc, scope)
     cameras = _cameras(loader, doc, scope)
-    if loader.diagnostics or tree is None:
+    if tree is None or not nodes_whole:  # a node left out would make its outputs look unwritten below
         raise InputError(loader.diagnostics)
     header = doc.header
     mission = MissionSpec(
@@ -266,7 +268,7 @@ def load_mission(
         files=tuple(dict.fromkeys(loader.files)),
         cameras=cameras, registry=loader.registry,
     )  # fmt: skip
-    problems = check_dataflow(mission)
+    problems = [*loader.diagnostics, *check_dataflow(mission)]  # every problem at once, not in stages
     if problems:
         raise InputError(problems)
     if cameras is None:  # grab what the nodes read, no more (missions/camera_use.py)

@@ -49,3 +49,13 @@ def test_bearings_missions_lists_the_shipped_missions_with_their_required_inputs
     out = capsys.readouterr().out
     assert out.startswith("explore: Explore with the stereo pair") and "square: Drive a square" in out
     assert "inputs: target (required), roadmap, seed" in out
+
+
+def test_top_level_input_and_data_flow_problems_come_together(write_mission):
+    guard = "Guard: {key: /map/nothing, op: '==', value: 1, child: {Drive: {distance: '${d}'}}}"
+    path = write_mission(f"mission: m\nrate: -1\ninputs: {{d: 1.0}}\ntree:\n  {guard}\n")
+    with pytest.raises(InputError) as info:
+        load_mission(path, overrides={"d": "far"})
+    said = str(info.value)
+    assert "rate" in said and "input 'd' expects a number" in said
+    assert "reads /map/nothing, which nothing writes" in said
