@@ -201,3 +201,21 @@ def test_the_harness_docstring_example_runs_as_written():
 
     example = behaviours.testing.__doc__.split("Example::")[1].split("Like the runner")[0]
     exec(compile(textwrap.dedent(example), "behaviours/testing.py", "exec"), {})  # noqa: S102
+
+
+def test_a_mission_using_a_plugin_survives_the_xml_round_trip(tmp_path, capsys):
+    (tmp_path / "corners.py").write_text(_python_block("missions.md", "Writing a behaviour"))
+    mission, xml, back = tmp_path / "corner.yaml", tmp_path / "corner.xml", tmp_path / "back.yaml"
+    mission.write_text("plugins: [corners.py]\ntree:\n  Sequence:\n    children:\n"
+                       "      - NearestCorner: {side: 2.0, goal: '{/mission/corner}'}\n      - Stop\n")
+    assert main(["show", str(mission), "--format", "xml", "-o", str(xml)]) == 0
+    assert main(["import", str(xml), "-o", str(back)]) == 2  # NearestCorner is not bearings' own
+    assert "NearestCorner" in capsys.readouterr().err
+    assert main(["import", str(xml), "-o", str(back), "--plugin", "corners.py"]) == 0
+    assert "plugins: [corners.py]" in back.read_text()
+    assert main(["validate", str(back)]) == 0
+    from missions.loader import load_mission
+
+    original, imported = load_mission(mission).tree, load_mission(back).tree
+    assert [n.type for n in imported.walk()] == [n.type for n in original.walk()]
+    assert imported.children[0].inputs == original.children[0].inputs
