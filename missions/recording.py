@@ -7,6 +7,7 @@ viewer, so it works headless; open the file later with ``rerun F.rrd``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -18,6 +19,7 @@ from py_trees.common import Status
 from behaviours.telemetry import Arrows, Drawing, Draws, Event, Lines, Picture, Plot, Points, Reports
 from missions.images import DEFAULT_RATE_HZ, ImageRate, jpeg
 
+FIGURE_PERIOD = 1.0  # s of the run's clock between two plots of the nodes' figures (some are costly to gather)
 STATUS_CODE = {Status.INVALID: 0, Status.RUNNING: 1, Status.SUCCESS: 2, Status.FAILURE: 3}
 
 
@@ -37,6 +39,7 @@ class Recorder:
         self._last_status: dict[str, Status] = {}
         self._last_figure: dict[str, Any] = {}
         self.images = ImageRate(image_rate_hz)
+        self._figures_at = -math.inf
         rr.log("tree/status_legend", rr.TextDocument("0 invalid, 1 running, 2 success, 3 failure"), static=True)
 
     def log_tick(self, *, time_s: float, tick: int, root: py_trees.behaviour.Behaviour, odometry: Any,
@@ -65,16 +68,19 @@ class Recorder:
                 self.image(f"camera/{name}_right", frame.right)
         for observer in observers:
             observer.log_rerun(rr)
+        figures = time_s - self._figures_at >= FIGURE_PERIOD
+        if figures:
+            self._figures_at = time_s
         for node in nodes:
-            self.log_node(node)
+            self.log_node(node, figures=figures)
 
     def image(self, entity: str, image: Any) -> None:
         """One image, JPEG-encoded (a tenth of the raw bytes of a camera image)."""
         self.rr.log(entity, self.rr.EncodedImage(contents=jpeg(image), media_type="image/jpeg"))
 
-    def log_node(self, node: Any) -> None:
-        """A node's figures (numbers, when they change) and drawings."""
-        if isinstance(node, Reports):
+    def log_node(self, node: Any, *, figures: bool = True) -> None:
+        """A node's drawings, and with ``figures`` its figures (the numbers that changed since last plotted)."""
+        if figures and isinstance(node, Reports):
             for figure in node.figures():
                 value = figure.value
                 if isinstance(value, (int, float)) and not isinstance(value, bool):
@@ -85,8 +91,6 @@ class Recorder:
         if isinstance(node, Draws):
             for drawing in node.drawings():
                 self.draw(drawing)
-        elif callable(log := getattr(node, "log_rerun", None)):  # issue 20: going
-            log(self.rr)
 
     def draw(self, drawing: Drawing) -> None:
         """One drawing as the rerun archetype that shows it."""

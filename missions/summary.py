@@ -19,8 +19,10 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from typing import Any
 
-ALWAYS = ("ground_truth.collisions", "ground_truth.min_clearance_m", "safety.safety_stops")
-"""Shown on every end-of-run line whose report has them."""
+ALWAYS = ("ground_truth.collisions", "ground_truth.min_clearance_m", "safety.safety_stops", "safety.slowdowns",
+          "safety.bumper_hits", "safety.min_range_m", "safety.sources")
+"""Shown on every end-of-run line whose report has them: what the robot touched or came close to
+(the simulator's ground truth) and what the collision monitor did about it."""
 
 UNITS = (("_m2", "m^2"), ("_m", "m"), ("_s", "s"), ("_deg", "deg"), ("_rad", "rad"), ("_hz", "Hz"))
 """Unit suffixes of report names, and how the line writes the unit."""

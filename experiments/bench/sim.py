@@ -2,11 +2,14 @@
 
 - ``panoramas_per_s_<world>``: rendered 720 x 172 panoramas (walls, floor, ceiling or sky and
   landmarks) per second in ``lab`` and ``outdoor``, along a path of poses, on one core
-  (``cv2.setNumThreads(1)`` for the measurement).
+  (``cv2.setNumThreads(1)`` for the measurement); ``lab_people``: ``lab`` with four people walking
+  across it (they step between frames), the cost of rendering people.
 - ``remap_reference_ms``: one bare ``cv2.remap`` of a 720 x 172 image with float maps, measured in
   the same run; ``panorama_cost_ratio_<world>`` = one panorama / that reference.
 - ``steps_per_s_bearings``: simulated steps per second in bearings mode (``lab``: command the
   base, step 50 ms, grab the ``landmarks`` sensor), the fast mode for large experiments.
+- ``sonar_read_ms``: one read of the sonar ring and bumpers after a 100 ms step (``lab``: about
+  three transducers per ring fire), what the runner's sensing branch adds to every tick.
 - ``other_cameras_ms``: per-frame times of the other rendered cameras in ``lab`` (after their
   lookup tables are built).
 """
@@ -17,12 +20,18 @@ import functools
 import math
 import time
 from collections.abc import Callable
+from dataclasses import replace
 
 import cv2
 import numpy as np
 
 from drivers.sim.simulation import Simulation
+from drivers.sim.world import load_world
+from drivers.sim.world_values import Person, TextureSpec
 from perception.geometry import Pose2D
+
+WALKERS = (((1.0, 4.0), (7.0, 4.0)), ((3.5, 1.0), (3.5, 5.0)), ((6.5, 1.2), (6.5, 4.8)), ((1.0, 1.0), (6.0, 5.0)))
+"""Four people walking across the lab (bench ``lab_people``)."""
 
 
 def _rate(fn: Callable[[int], object], count: int, repeats: int = 3) -> float:
@@ -65,8 +74,8 @@ def _measure(quick: bool) -> dict:
     map_u, map_v = (u * 0.97 + 5.0).astype(np.float32), (v * 0.95 + 3.0).astype(np.float32)
     remap_rate = _rate(lambda i: cv2.remap(image, map_u, map_v, cv2.INTER_LINEAR), n)
     figures["remap_reference_ms"] = round(1e3 / remap_rate, 4)
-    for world in ("lab", "outdoor"):
-        sim = Simulation.load(world, seed=0)
+    for world in ("lab", "outdoor", "lab_people"):
+        sim = _lab_with_people() if world == "lab_people" else Simulation.load(world, seed=0)
         poses = _path(sim, 64)
         sim.snapshot(poses[0])  # textures and lookup tables are built once, outside the timing
         rate = _rate(functools.partial(_snapshot_on_path, sim, poses), n)
@@ -81,6 +90,15 @@ def _measure(quick: bool) -> dict:
         sensor.grab()
 
     figures["steps_per_s_bearings"] = round(_rate(bearings_step, n, repeats=1), 1)
+    ranges = sim.robot.ranges
+    assert ranges is not None, "the lab's robot has the default sonar ring"
+
+    def sonar_step(i: int) -> None:
+        sim.step(0.1)
+        ranges.read()
+
+    step_rate = _rate(lambda i: sim.step(0.1), n)
+    figures["sonar_read_ms"] = round(max(0.0, 1e3 / _rate(sonar_step, n) - 1e3 / step_rate), 4)
 
     sim = Simulation.load("lab", seed=0)
     start = sim.world.start
@@ -92,7 +110,17 @@ def _measure(quick: bool) -> dict:
     return figures
 
 
+def _lab_with_people() -> Simulation:
+    lab = load_world("lab")
+    people = tuple(Person(path, 0.25, 1.75, TextureSpec(seed=500 + i, feature_size=0.1, brightness=90.0))
+                   for i, path in enumerate(WALKERS))
+    return Simulation(replace(lab, people=people, name="lab_people"), seed=0)
+
+
 def _snapshot_on_path(sim: Simulation, poses: list[Pose2D], i: int) -> object:
+    if sim.world.people:  # the people walk on between frames (the robot far away: nobody waits)
+        sim.crowd.step(0.1, (1e6, 1e6), sim.world.robot_radius)
+        sim.scene.move_people(sim.crowd.xy)
     return sim.snapshot(poses[i % len(poses)])
 
 

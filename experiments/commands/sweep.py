@@ -31,7 +31,9 @@ DESCRIPTION = """Run MISSION once per world x seed x combination of --set values
 Dask cluster. Results go to RESULTS_DIR: results.jsonl (one row per run: its parameters, status,
 reason, times and the report's figures flattened), reports/<id>.json, logs/<id>.log (output of
 runs that crashed, hung or were killed) and summary.json (per combination: success rate, mean and
-spread of every figure), which is also printed.
+spread of every figure), which is also printed. A run succeeded when its mission ended in SUCCESS
+without a collision; the table counts the runs that collided, the collision monitor's stops and
+the true minimum clearance.
 
 A run that fails, crashes, is killed or hangs past --timeout is one row with its reason; the sweep
 goes on. Ctrl-C kills the running episodes and keeps every finished row; --resume continues.

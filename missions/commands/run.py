@@ -10,6 +10,7 @@ from typing import Any
 from behaviours.clock import TickClock
 from drivers.interfaces import KeyboardOpener, Robot
 from drivers.keyboard import TerminalKeys
+from drivers.safety.settings import monitor_config
 from maps.located import validate
 from maps.store import Diagnostic, InputError, output_problem, write_json
 from missions.clocks import Paced, WallClock, paced_when_operated
@@ -20,7 +21,9 @@ from missions.progress import progress_for
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
 from missions.summary import summary_line
+from perception.collision_monitor import MonitorConfig
 from perception.geometry import Pose2D
+from perception.polygons import disc
 
 DESCRIPTION = """Run a mission until its tree ends in SUCCESS or FAILURE.
 
@@ -28,6 +31,11 @@ Without --robot the mission runs in the built-in simulator (--sim WORLD picks a 
 name or a world file; the default is an empty plane), as fast as the machine allows unless
 --realtime is given or an operator drives by keys (real time from when a key node first runs).
 The same seed gives the same run, bit for bit.
+
+Every command passes the collision monitor on its way to the base: it stops the robot short of
+what its range sensors see, slows it near obstacles, and crawls when they fall silent (the
+robot profile's safety: section; in the simulator, zones around the world's robot disc). The
+report's safety section and the last lines printed count its stops.
 
 Whatever happens (the tree ends, a behaviour raises or blocks, Ctrl-C, SIGTERM, --max-time), the
 base and the pan-tilt unit are commanded to stop before the drivers close, and --report is
@@ -76,18 +84,19 @@ def run(args: argparse.Namespace) -> int:
             numbers = _numbers(args)
             _prepare_outputs(args)
             mission = load_from_args(args.mission, args, to_run=True)
-            simulation, robot, clock = _open(args, numbers.seed)
+            simulation, robot, clock, safety = _open(args, numbers.seed)
         except InputError as exc:
             return print_input_error(exc)
         except Interrupted as exc:
             return _interrupted_early(args, exc.signum)
         try:
-            return _run(args, mission, (simulation, robot, clock), numbers)
+            return _run(args, mission, (simulation, robot, clock), numbers, safety)
         finally:
             robot.close()
 
 
-def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickClock], numbers: RunArguments) -> int:
+def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickClock], numbers: RunArguments,
+         safety: MonitorConfig) -> int:
     simulation, robot, clock = opened
     missing = robot.missing_cameras(mission.cameras or ())
     if missing:
@@ -106,14 +115,14 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
     progress = progress_for(mission.name, sys.stderr, asked=args.progress, quiet=args.quiet)
     try:
         result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
-                        on_tick=progress, keyboard=keyboard).run()
+                        on_tick=progress, keyboard=keyboard, safety=safety).run()
     finally:
         if progress is not None:
             progress.close()
     clock_name = "sim" if simulation is not None else "wall"
     print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock_name} time, {result.ticks} ticks "
           f"({result.reason})")
-    summary = summary_line(result.report)
+    summary = summary_line(result.report)  # collisions, safety stops, clearance, each capability's headline
     if summary:
         print(summary)
     if args.report:
@@ -155,19 +164,24 @@ def _interrupted_early(args: argparse.Namespace, signum: int) -> int:
     return exit_code(signum)
 
 
-def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock]:
-    """(simulation or None, robot, the clock the run ticks on)."""
+def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock, MonitorConfig]:
+    """(simulation or None, robot, the clock the run ticks on, the collision monitor's configuration)."""
     if args.robot:
-        from missions.profiles import open_robot
+        from missions.profiles import open_robot, robot_safety
 
         if args.start:
             raise InputError([Diagnostic("--start", 0, 0, "sets the simulated robot's start; a real robot starts "
                                          "where it stands")])
         clock = WallClock()  # one time axis for the drivers' stamps and the tree
         try:
-            return None, open_robot(args.robot, clock=clock.now), clock
+            robot = open_robot(args.robot, clock=clock.now)
         except OSError as exc:
             raise InputError([Diagnostic(args.robot, 0, 0, f"cannot open the robot: {exc}")]) from None
+        try:
+            return None, robot, clock, robot_safety(args.robot, robot)
+        except InputError:
+            robot.close()
+            raise
     from drivers.sim.simulation import Simulation
     from drivers.sim.world import load_world
 
@@ -176,7 +190,7 @@ def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock]:
     except (OSError, ValueError) as exc:  # InputError (a bad world file) passes through as it is
         raise InputError([Diagnostic(str(args.sim), 0, 0, str(exc))]) from None
     simulation = Simulation(world, seed=seed, start=_start_pose(args.start, world))
-    return simulation, simulation.robot, simulation.clock()
+    return simulation, simulation.robot, simulation.clock(), monitor_config(None, disc(world.robot_radius))
 
 
 def _start_pose(text: str | None, world: Any) -> Pose2D | None:

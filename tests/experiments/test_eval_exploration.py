@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from behaviours.exploration import pack_cells
 from drivers.sim.world import load_world
 from experiments.eval.exploration import check_world, episode_figures, episodes, seen_floor, summarise_variant
-from maps.exploration import StereoHead, footprint
+from maps.exploration.codec import pack_cells
+from maps.exploration.head import StereoHead, footprint
 from missions.cli import main
 from perception.geometry import Pose2D
 

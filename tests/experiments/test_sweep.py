@@ -123,6 +123,19 @@ def test_the_summary_says_why_runs_did_not_succeed_commonest_first():
                                       "1 x no reason")
 
 
+def test_a_success_that_collided_is_not_a_success():
+    rows = [{"id": f"e{i}", "mission": "m", "world": "lab", "seed": i, "max_time_s": None, "status": "SUCCESS",
+             "ground_truth.collisions": collisions, "safety.safety_stops": stops, "ground_truth.min_clearance_m": gap}
+            for i, (collisions, stops, gap) in enumerate([(0, 1, 0.12), (2, 0, 0.0), (0, 3, 0.08)])]
+    (entry,) = summarise(rows)
+    assert (entry["success"], entry["collided"], entry["success_rate"]) == (2, 1, 2 / 3)
+    assert entry["figures"]["safety.safety_stops"]["mean"] == pytest.approx(4 / 3)
+    assert entry["figures"]["ground_truth.min_clearance_m"]["min"] == 0.0
+    header = format_summary([entry]).splitlines()[0].split()
+    assert {"collided", "safety_stops", "min_clearance_m"} <= set(header)
+    assert entry["reasons"] == [{"reason": "the mission succeeded but the robot collided", "count": 1}]
+
+
 # --------------------------------------------------------------------------------------------
 # Sweeps
 

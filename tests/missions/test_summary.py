@@ -40,7 +40,7 @@ def test_a_run_prints_its_collisions_and_the_report_lists_the_headline(tmp_path,
     report = tmp_path / "r.json"
     assert main(["run", "square", "--sim", "lab", "--quiet", "--set", "side=0.5", "--report", str(report)]) == 0
     out = capsys.readouterr().out
-    assert "ground truth: collisions 0, goal error" in out
+    assert "ground truth: collisions 0, min clearance " in out and ", goal error " in out
     import json
 
     headline = json.loads(report.read_text())["headline"]

@@ -1,6 +1,6 @@
 """Where the stereo pair on the pan-tilt unit looks while the robot drives (algorithm 3, eq. 3-5).
 
-The cameras watch interest edges (:mod:`maps.exploration`, eq. 2): they pan to keep an edge's
+The cameras watch interest edges (:mod:`maps.exploration.interest`, eq. 2): they pan to keep an edge's
 closer point in view, up to 90 degrees off the heading (eq. 3); the robot slows down when the pan
 rate needed would exceed what the unit can do (eq. 4); when the point leaves that range the head
 turns back (to the front, or to the remembered point ``P_A`` on the other side); and the cameras
@@ -41,7 +41,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from maps.exploration import ExplorationMap, Interest, StereoHead
+from maps.exploration.grid import ExplorationMap
+from maps.exploration.head import StereoHead
+from maps.exploration.interest import Interest, closer_points
 from perception.geometry import Pose2D, wrap_angles
 
 
@@ -140,10 +142,7 @@ def _sight(gaze: Gaze, m: ExplorationMap, robot: Pose2D, params: GazeParams) -> 
     live = np.flatnonzero(m.interest != Interest.NEVER)
     closer, bearing, rho = np.zeros((n, 3)), np.full(n, np.inf), np.full(n, np.inf)
     if len(live):
-        eye = np.array([*axis, params.head.lens_height])
-        a, b = m.points[m.edges[live, 0]], m.points[m.edges[live, 1]]
-        a_closer = np.einsum("ij,ij->i", a - eye, a - eye) <= np.einsum("ij,ij->i", b - eye, b - eye)
-        closer[live] = np.where(a_closer[:, None], a, b)  # as maps.exploration.closer_points
+        closer[live] = closer_points(m, np.array([*axis, params.head.lens_height]), live)
         bearing[live] = pan_to_point(robot, axis, closer[live, :2])
         rho[live] = np.hypot(closer[live, 0] - axis[0], closer[live, 1] - axis[1])
     reach = np.abs(bearing) <= params.max_pan

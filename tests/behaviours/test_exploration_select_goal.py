@@ -1,104 +1,19 @@
-"""MapStereo and SelectGoalPoint alone: hand-set blackboard, manual clock."""
+"""SelectGoalPoint alone: hand-set map and pose, manual clock."""
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.exploration import MapStereo, SelectGoalPoint, drop_jumps, pack_cells, unpack_cells
+from behaviours.exploration.select_goal import SelectGoalPoint
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
-from drivers.sim.simulation import Simulation
-from maps.exploration import Cell, ExplorationMap, GridFrame
-from maps.exploration_goal import Mode
+from maps.exploration.goal import Mode
+from maps.exploration.grid import Cell, ExplorationMap, GridFrame
 from perception.geometry import Pose2D
 
 MAP, GOAL, POSE = "/map/exploration", "/map/exploration_goal", "/robot/pose"
-
-
-# --------------------------------------------------------------------------------------------
-# MapStereo
-
-
-@pytest.fixture(scope="module")
-def stereo_frame():
-    """One stereo pair from the lab, the head tilted down 30 degrees (rendered once)."""
-    sim = Simulation.load("lab", seed=0, noise=False)
-    sim.ptu.move(0.0, math.radians(-30.0), 10.0)
-    sim.step(0.5)
-    return sim.robot.cameras["stereo"].grab(), sim.ptu.state()
-
-
-def test_the_first_tick_marks_the_start_disc_and_nothing_ticks_without_a_pose():
-    harness = BehaviourHarness(MapStereo(start_radius=0.6, odometry="{/robot/pose}"))
-    assert harness.tick() == Status.RUNNING and harness.read(MAP) is None
-    harness.write(POSE, Pose2D(1.0, 2.0, 0.3))
-    assert harness.tick() == Status.RUNNING
-    m = harness.read(MAP)
-    assert m.explored_area == pytest.approx(math.pi * 0.6**2, rel=0.05)
-    assert m.cell_state(np.array([[1.0, 2.0], [1.5, 2.0], [1.7, 2.0]])).tolist() == [Cell.FREE, Cell.FREE, Cell.UNKNOWN]
-
-
-def test_stereo_is_integrated_once_per_new_frame_and_period(stereo_frame):
-    frame, ptu = stereo_frame
-    harness = BehaviourHarness(MapStereo(period=0.4, odometry="{/robot/pose}"),
-                               blackboard={POSE: Pose2D(), "/ptu/state": ptu, "/perception/frames": {"stereo": frame}})
-    harness.tick()
-    m = harness.read(MAP)
-    assert len(m.points) > 500 and m.explored_area > 3.0  # the floor ahead, up to 3 m
-    assert len(harness.behaviour.scans) == 1
-    later = type(frame)(frame.image, frame.camera, frame.stamp + 0.2, frame.camera_name, frame.right)
-    harness.write("/perception/frames", {"stereo": later})
-    harness.clock.advance(0.2)
-    harness.tick()  # a new frame, but within the period of the last integration
-    assert len(harness.behaviour.scans) == 1
-    newer = type(frame)(frame.image, frame.camera, frame.stamp + 0.5, frame.camera_name, frame.right)
-    harness.write("/perception/frames", {"stereo": newer})
-    harness.clock.advance(0.3)
-    harness.tick()  # the period is over
-    assert len(harness.behaviour.scans) == 2
-    harness.clock.advance(0.5)
-    harness.tick()  # the same frame again: nothing new
-    assert len(harness.behaviour.scans) == 2
-
-
-def test_the_report_has_the_map_and_the_scans(stereo_frame):
-    frame, ptu = stereo_frame
-    harness = BehaviourHarness(MapStereo(odometry="{/robot/pose}"),
-                               blackboard={POSE: Pose2D(), "/ptu/state": ptu, "/perception/frames": {"stereo": frame}})
-    harness.tick()
-    section = harness.behaviour.report_sections()["exploration"]
-    scan = section["scans"][0]
-    assert scan[:3] == [0.0, 0.0, round(ptu.tilt, 4)] and len(scan) == 3 + section["scan"]["bins"]
-    assert section["scan"]["bins"] == math.ceil(math.degrees(section["scan"]["horizontal_fov"]))
-    m = harness.read(MAP)
-    cells = unpack_cells(section["map"]["explored"], m.frame.rows, m.frame.cols)
-    assert np.array_equal(cells, m.cells == Cell.FREE)
-    assert section["explored_area_m2"] == pytest.approx(m.explored_area)
-
-
-def test_pixels_beside_a_depth_jump_are_dropped():
-    depth = np.full((20, 30), 2.0, dtype=np.float32)
-    depth[:, 15:] = 5.0  # a jamb at 2 m in front of a wall at 5 m
-    depth[0, 0] = np.nan
-    out = drop_jumps(depth, 0.15, radius=3)
-    dropped = np.flatnonzero(np.isnan(out[10]))
-    assert dropped.tolist() == list(range(12, 18))  # 3 px either side of the edge
-    assert np.isnan(out[0, 0]) and out[10, 5] == 2.0 and out[10, 25] == 5.0
-    gentle = np.tile(np.linspace(2.0, 2.2, 30, dtype=np.float32), (20, 1))  # a floor: 0.7 % a pixel
-    assert np.isfinite(drop_jumps(gentle, 0.15)).all()
-    assert drop_jumps(depth, 0.0) is depth
-
-
-def test_packed_cells_round_trip():
-    mask = np.random.default_rng(1).random((7, 13)) > 0.5
-    assert np.array_equal(unpack_cells(pack_cells(mask), 7, 13), mask)
-
-
-# --------------------------------------------------------------------------------------------
-# SelectGoalPoint
 
 
 def explored_room(points: list[list[float]], *, walled: bool = True) -> ExplorationMap:
@@ -144,7 +59,7 @@ def test_frontier_mode_without_points_and_back_when_one_appears():
     harness.clock.advance(0.6)
     harness.tick()
     assert harness.read(GOAL).mode is Mode.ATTRACTION
-    section = harness.behaviour.report_sections()["exploration"]
+    section = report_sections(harness.behaviour)["exploration"]
     assert section["mode_switches"] == [[0.0, "attraction", "frontier"], [1.1, "frontier", "attraction"]]
     assert section["goal_count"] == 2
 
@@ -181,7 +96,7 @@ def test_no_reachable_border_fails_until_patience_then_succeeds():
     assert harness.tick() == Status.FAILURE  # look around, then ask again
     assert "look around" in harness.behaviour.feedback_message
     assert harness.tick() == Status.SUCCESS
-    assert harness.behaviour.report_sections()["exploration"]["done"] is True
+    assert report_sections(harness.behaviour)["exploration"]["done"] is True
 
 
 def test_a_goal_abandoned_by_a_halt_is_avoided():
@@ -232,7 +147,7 @@ def test_a_border_closed_by_a_clump_is_looked_at_again_before_done():
     assert harness.tick() == Status.FAILURE  # the place is verified; nothing else to look at: a strike
     assert harness.behaviour.verified == [goal.blocked] and harness.behaviour.switch.strikes == 1
     assert harness.tick() == Status.SUCCESS
-    assert harness.behaviour.report_sections()["exploration"]["verifications"] == 1
+    assert report_sections(harness.behaviour)["exploration"]["verifications"] == 1
 
 
 def test_a_clump_that_clears_when_looked_at_opens_the_border():
@@ -245,3 +160,43 @@ def test_a_clump_that_clears_when_looked_at_opens_the_border():
     goal = harness.read(GOAL)
     assert goal.mode is Mode.ATTRACTION and goal.target[0] == pytest.approx(3.05)
     assert harness.behaviour.verified == []  # the look was not needed to the end
+
+
+def test_the_report_keeps_its_shape():
+    harness = BehaviourHarness(select(), blackboard={MAP: explored_room([FAR_EAST]), POSE: Pose2D(0.5, 1.0)})
+    harness.tick()
+    section = report_sections(harness.behaviour)["exploration"]
+    assert list(section) == ["mode", "done", "strategy", "selections", "goals_reached", "goals_abandoned",
+                             "verifications", "goal_count", "goals", "goal_columns", "mode_switch_count",
+                             "mode_switches"]
+    goal = harness.read(GOAL)
+    assert section["goals"] == [[0.0, "attraction", 3.05, 1.05, 0, round(goal.distance, 3), round(goal.cost, 3),
+                                 round(goal.power, 3)]]
+
+
+def test_a_new_goal_is_drawn_once_with_its_path():
+    harness = BehaviourHarness(select(), blackboard={MAP: explored_room([FAR_EAST]), POSE: Pose2D(0.5, 1.0)})
+    node = harness.behaviour
+    assert list(node.drawings()) == []  # no goal yet
+    harness.tick()
+    target, path = node.drawings()
+    assert target.entity == "odometry_frame/exploration/goal" and target.labels == ("attraction",)
+    assert target.positions[0] == pytest.approx((3.05, 1.05)) and target.colours == (255, 80, 80)
+    assert path.entity == "odometry_frame/exploration/path" and path.strips[0] is harness.read(GOAL).path
+    assert list(node.drawings()) == []  # the same goal: drawn already
+
+
+def test_the_second_chance_reuses_the_first_selections_travel_cost(monkeypatch):
+    """One travel-cost search per tick, however many selections that tick makes from the same place."""
+    import maps.exploration.goal as goal_module
+
+    searches = []
+    real = goal_module.travel_cost
+    monkeypatch.setattr(goal_module, "travel_cost", lambda *a, **k: searches.append(1) or real(*a, **k))
+    harness = BehaviourHarness(select(patience=1), blackboard={MAP: explored_room([]), POSE: Pose2D(0.5, 1.0)})
+    harness.tick()
+    first = harness.read(GOAL).target
+    harness.halt()  # abandoned: avoided
+    searches.clear()
+    assert harness.tick() == Status.RUNNING and harness.behaviour.selections == 3  # none, then the second chance
+    assert harness.read(GOAL).target == pytest.approx(first) and len(searches) == 1

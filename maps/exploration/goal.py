@@ -6,7 +6,7 @@ The next goal is the detected point ``P_p`` with the highest attractive power
 
 where ``P_b`` is a border point of the explored area, ``d`` the plan distance from the point's
 floor projection to it and ``G`` the travel cost from the robot through known free space
-(:func:`maps.exploration.travel_cost`). When no point lies farther than ``K`` beyond the border,
+(:func:`maps.exploration.travel.travel_cost`). When no point lies farther than ``K`` beyond the border,
 the robot is in *frontier mode* until one does; exploration is *done* when no border is
 reachable. The mode switching is the small value :class:`ModeSwitch`, so the behaviour that uses
 it only reads the map, calls :func:`select_goal` and writes the goal.
@@ -26,14 +26,14 @@ Choices where the paper is vague:
 - DONE is absorbing (the mission has succeeded); a new :class:`ModeSwitch` starts over. The
   paper ends at the first selection without a reachable border; ``patience`` > 1 waits for that
   many in a row, and in between :func:`select_goal` returns no goal in a mode that is not DONE:
-  the behaviour looks around (:func:`maps.exploration_gaze.survey`) and asks again: a second
+  the behaviour looks around (:func:`maps.exploration.gaze.survey`) and asks again: a second
   look clears the speckle of the stereo matcher in a doorway (see ``EvidenceParams``), though
   not walls smeared by odometry drift.
 - A point the robot went for once and reached is ``spent`` (:meth:`ModeSwitch.spend`): it can no
   longer attract, so a point whose surroundings cannot be explored (under a desk, behind glass)
   does not hold the robot forever. Spent points do not count for "a point has d > K" either.
 - Selection on a map with no explored free cell raises: mark the robot's footprint first
-  (:func:`maps.exploration.mark_traversed`), otherwise the first call would be "done".
+  (:func:`maps.exploration.grid.mark_traversed`), otherwise the first call would be "done".
 - Selection is repeated as the map grows; two nearly equal points would make the robot dither
   between them. With ``hysteresis`` > 0 the ``current`` goal's point is kept while its attractive
   power is within that of the best (in frontier mode: its border point, while its travel cost is
@@ -63,7 +63,8 @@ from enum import StrEnum
 import numpy as np
 from scipy.spatial import cKDTree
 
-from maps.exploration import Cell, ExplorationMap, TravelCost, borders, clearance, travel_cost, traversable
+from maps.exploration.grid import Cell, ExplorationMap, borders
+from maps.exploration.travel import TravelCost, travel_cost, traversable
 
 
 class Mode(StrEnum):
@@ -84,7 +85,7 @@ class GoalParams:
     robot_radius: float = 0.26  # m: clearance the path keeps from obstacle cells
     min_frontier: float = 0.3  # m: shorter border pieces are ignored
     margin: float = 0.0  # m: steps with less clearance than robot_radius + margin cost more...
-    penalty: float = 0.0  # ...up to (1 + penalty) times their length (see maps.exploration.travel_cost)
+    penalty: float = 0.0  # ...up to (1 + penalty) times their length (see maps.exploration.travel.travel_cost)
     patience: int = 1  # selections in a row without a reachable border before DONE (1: the paper)
     hysteresis: float = 0.0  # m: keep the current goal while it is this close to the best (see the docstring)
     avoid_radius: float = 0.4  # m: border points this close to an avoided target are no candidates
@@ -173,12 +174,25 @@ def attractive_power(distance: np.ndarray, cost: np.ndarray, eta: float) -> np.n
     return np.asarray(distance, dtype=np.float64) - eta * np.asarray(cost, dtype=np.float64)  # eq. 1
 
 
+def goal_travel(m: ExplorationMap, robot: tuple[float, float], params: GoalParams = GoalParams()) -> TravelCost:
+    """G(v_S, .) from ``robot`` as goal selection sees it (the disc of ``robot_radius``, ``margin``,
+    ``penalty``): one search serves every selection from that place on that map."""
+    return travel_cost(m, robot, params.robot_radius, margin=params.margin, penalty=params.penalty)
+
+
 def candidates(
-    m: ExplorationMap, robot: tuple[float, float], params: GoalParams = GoalParams(), avoid: np.ndarray | None = None
+    m: ExplorationMap,
+    robot: tuple[float, float],
+    params: GoalParams = GoalParams(),
+    avoid: np.ndarray | None = None,
+    *,
+    travel: TravelCost | None = None,
 ) -> Candidates:
     """Reachable border points (none within ``avoid_radius`` of an ``avoid`` point, K x 2), and d, P_b
-    and A_P (eq. 1) of every map point, seen from ``robot``."""
-    travel = travel_cost(m, robot, params.robot_radius, margin=params.margin, penalty=params.penalty)
+    and A_P (eq. 1) of every map point, seen from ``robot``. ``travel``: :func:`goal_travel` of the
+    same map, place and parameters, when the caller has it already."""
+    if travel is None:
+        travel = goal_travel(m, robot, params)
     min_cells = max(1, int(math.ceil(params.min_frontier / m.frame.resolution)))
     rows, cols = np.nonzero(borders(m, min_cells) & np.isfinite(travel.cost))
     border = m.frame.centre_of(rows, cols)
@@ -195,7 +209,7 @@ def candidates(
         rows, cols = m.frame.cell_of(m.points[:, :2])
         inside = m.frame.inside(rows, cols)
         room = np.full(n, np.inf)
-        room[inside] = clearance(m)[rows[inside], cols[inside]]
+        room[inside] = m.clearance[rows[inside], cols[inside]]
         eligible &= room > params.point_clearance
     distance = np.where(eligible, distance, 0.0)
     power = attractive_power(distance, border_cost[nearest], params.eta)
@@ -210,18 +224,20 @@ def select_goal(
     *,
     current: Goal | None = None,
     avoid: np.ndarray | None = None,
+    travel: TravelCost | None = None,
 ) -> tuple[ModeSwitch, Goal | None]:
     """The next mode and goal for a robot at ``robot`` (odometry x, y).
 
     ``current``: the goal being driven to (kept within ``hysteresis``); ``avoid``: targets (K x 2)
-    whose border points are no candidates. No goal: DONE, or (with ``patience`` > 1) no border
-    reachable yet again: look around, retry.
+    whose border points are no candidates; ``travel``: :func:`goal_travel` of this map and place,
+    when the caller has it (a second selection from the same place). No goal: DONE, or (with
+    ``patience`` > 1) no border reachable yet again: look around, retry.
     """
     if not np.any(m.cells == Cell.FREE):
         raise ValueError("the exploration map has no explored free cell: mark the robot's footprint first")
     if switch.mode is Mode.DONE:
         return switch, None
-    found = candidates(m, robot, params, avoid)
+    found = candidates(m, robot, params, avoid, travel=travel)
     eligible = found.distance > params.k
     if switch.spent:
         eligible[np.fromiter(switch.spent, dtype=np.int64)] = False

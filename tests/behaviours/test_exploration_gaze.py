@@ -9,13 +9,16 @@ import pytest
 from py_trees.common import Status
 
 from behaviours.control import Parallel
-from behaviours.follow_path import FollowPath
-from behaviours.gaze import LookAround, WatchInterestEdges
+from behaviours.exploration.follow_path import FollowPath
+from behaviours.exploration.gaze import LookAround, WatchInterestEdges
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import PanTiltState
-from maps.exploration import Cell, ExplorationMap, GridFrame, Interest, StereoHead
-from maps.exploration_gaze import GazeParams, camera_lift, speed_limit, survey
-from maps.exploration_goal import Goal, Mode
+from maps.exploration.gaze import GazeParams, camera_lift, speed_limit, survey
+from maps.exploration.goal import Goal, Mode
+from maps.exploration.grid import Cell, ExplorationMap, GridFrame
+from maps.exploration.head import StereoHead
+from maps.exploration.interest import Interest
 from perception.geometry import Pose2D
 
 HEAD = StereoHead()  # the defaults of the ports: the simulator's stereo pair on the PTU-D46
@@ -64,7 +67,7 @@ def test_a_slow_unit_limits_the_speed_by_eq4():
     gamma, rho = math.atan2(1.0, 2.0), math.hypot(2.0, 1.0)
     assert harness.read(LIMIT) == pytest.approx(speed_limit(rho, gamma, math.radians(5.0) * 0.8))  # eq. 4
     assert harness.read(LIMIT) < 0.4
-    assert harness.behaviour.report_sections()["exploration"]["gaze_speed_limited_fraction"] == 1.0
+    assert report_sections(harness.behaviour)["exploration"]["gaze_speed_limited_fraction"] == 1.0
 
 
 def test_the_turn_rate_enters_eq4():
@@ -179,3 +182,41 @@ def test_look_around_holds_a_pose_until_the_unit_is_there():
         assert harness.tick() == Status.RUNNING
         harness.clock.advance(0.2)
     assert first is None and harness.behaviour.index == 0
+
+
+def test_the_gaze_report_keeps_its_shape():
+    harness = BehaviourHarness(watch(), blackboard={"/map/exploration": edge_map(LEFT), "/robot/odometry": Pose2D()})
+    harness.tick()
+    harness.write("/robot/odometry", Pose2D(3.0, 0.0, 0.0))  # the point leaves the view
+    harness.tick()
+    assert report_sections(harness.behaviour) == {"exploration": {
+        "gaze_mode": "edges", "gaze_watching_fraction": 0.5, "gaze_edges_watched": 1, "gaze_switches": 0,
+        "gaze_speed_limited_fraction": 0.0, "gaze_look_ahead_fraction": 0.0}}
+
+
+def test_where_the_cameras_look_is_drawn_every_tick():
+    harness = BehaviourHarness(watch(), blackboard={"/map/exploration": edge_map(LEFT), "/robot/odometry": Pose2D()})
+    node = harness.behaviour
+    assert list(node.drawings()) == []  # nothing commanded yet
+    harness.tick()
+    ray, watched = node.drawings()
+    assert ray.entity == "odometry_frame/exploration/gaze" and ray.origins.tolist() == [[0.1, 0.0]]  # the pan axis
+    reach = 1.5 * math.cos(harness.read(PTU).tilt)
+    assert ray.vectors[0] == pytest.approx(reach * np.array([2.0, 1.0]) / math.sqrt(5.0))  # towards the edge
+    assert watched.entity == "odometry_frame/exploration/watched" and watched.positions.tolist() == [[2.1, 1.0]]
+    assert [d.entity for d in node.drawings()] == [ray.entity, watched.entity]  # again: it is every tick
+    harness.write("/robot/odometry", Pose2D(3.0, 0.0, 0.0))
+    harness.tick()
+    assert next(d for d in node.drawings() if d.entity.endswith("watched")).positions.shape == (0, 2)
+
+
+def test_each_look_around_node_counts_its_surveys_under_its_name():
+    look = LookAround(name="look around again", settle=0.0)
+    harness = BehaviourHarness(look)
+    for _ in range(200):
+        cmd = harness.read(PTU)
+        if cmd is not None:
+            harness.write("/ptu/state", PanTiltState(cmd.pan, cmd.tilt, False))
+        if harness.tick() == Status.SUCCESS:
+            break
+    assert report_sections(look) == {"exploration": {"look_arounds_look_around_again": 1}}

@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.follow_path import FollowPath
+from behaviours.exploration.follow_path import FollowPath, disc_cells
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP
-from maps.exploration import Cell, ExplorationMap, GridFrame
-from maps.exploration_goal import Goal, Mode
+from maps.exploration.goal import Goal, Mode
+from maps.exploration.grid import Cell, ExplorationMap, GridFrame
 from perception.geometry import Pose2D
 
 FRAME = GridFrame(-1.0, -1.0, 0.05, 40, 100)  # x -1..4, y -1..1
@@ -142,7 +143,7 @@ def test_a_stall_backs_away_then_gives_up():
     assert harness.tick() == Status.RUNNING  # the second stall
     harness.clock.advance(0.6)
     assert harness.tick() == Status.FAILURE
-    assert harness.behaviour.report_sections()["exploration"]["stalls"] == 3
+    assert report_sections(harness.behaviour)["exploration"]["stalls"] == 3
 
 
 def with_obstacles(*xy: tuple[float, float]) -> ExplorationMap:
@@ -182,3 +183,35 @@ def test_a_path_with_just_enough_clearance_is_not_blocked():
     cells[rows, cols] = Cell.OBSTACLE  # the jambs: cell centres (1.025, +-0.325) and the path at y 0.025
     harness = follow(ExplorationMap.from_cells(FRAME, cells), goal_to(3.0))
     assert harness.tick() == Status.RUNNING and harness.behaviour.replans == 0
+
+
+def test_disc_cells_are_the_cells_within_the_radius_of_any_centre():
+    m = room(wall_at=1.0)
+    # by hand: a disc of 0.06 m round a cell corner covers the four cells around it (centres 0.035 away)
+    assert sorted(disc_cells(m, np.array([[0.0, 0.0]]), 0.06).tolist()) == [Cell.FREE] * 4
+    # the wall's cells have centres at x 0.975 and 1.025: from (0.9, 0) those at y +-0.025 lie 0.079 m away,
+    # those at y +-0.075 0.106 m
+    assert np.count_nonzero(disc_cells(m, np.array([[0.9, 0.0]]), 0.1) == Cell.OBSTACLE) == 2
+    clear = disc_cells(m, np.array([[0.8, 0.0], [3.95, 0.95]]), 0.1)
+    assert np.count_nonzero(clear == Cell.OBSTACLE) == 0
+    assert np.count_nonzero(clear == Cell.UNKNOWN) > 0  # beyond the grid's corner at (4, 1): unknown
+
+
+def test_the_report_keeps_its_shape_and_the_path_is_drawn_when_it_changes():
+    m = room()
+    cells = m.cells.copy()
+    rows, cols = FRAME.cell_of(np.array([[1.0, 0.0]]))
+    cells[rows[0] - 2 : rows[0] + 3, cols[0] - 2 : cols[0] + 3] = Cell.OBSTACLE  # a post on the path
+    harness = follow(room(), goal_to(3.0))
+    node = harness.behaviour
+    harness.tick()
+    (followed,) = node.drawings()
+    assert followed.entity == "odometry_frame/exploration/followed" and followed.strips[0] is node.path
+    assert followed.colours == (255, 255, 255) and followed.radius == pytest.approx(0.015)
+    harness.tick()
+    assert list(node.drawings()) == []  # the same path
+    harness.write("/map/exploration", ExplorationMap.from_cells(FRAME, cells))
+    harness.tick()  # re-planned round the post
+    assert node.replans == 1 and [d.entity for d in node.drawings()] == ["odometry_frame/exploration/followed"]
+    assert report_sections(node) == {"exploration": {"stalls": 0, "replans": 1, "stuck": 0, "safety_stops": 0,
+                                                     "blind_stops": 0}}
