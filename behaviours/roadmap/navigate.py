@@ -1,4 +1,4 @@
-"""Navigating the roadmap to a target from an unknown pose (DESIGN.md, algorithm 2, "Navigation").
+"""Navigating the roadmap to a target from an unknown pose (docs/design.md, method 2, "Navigation").
 
 Paper: rotate and try to match any graph image; when none matches, move randomly and retry;
 then take the shortest path (edge cost sigma_x + sigma_y), homing at each node to remove drift.

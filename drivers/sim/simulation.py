@@ -280,7 +280,7 @@ class Simulation:
         reference_path: Sequence[Sequence[float]] | None = None,
         frame: str = "world",
     ) -> dict:
-        """The ``ground_truth`` section of a run report (DESIGN.md, contracts).
+        """The ``ground_truth`` section of a run report (docs/design.md, contracts).
 
         Always: ``trajectory_length_m``, ``final_pose``, ``odometry_drift_m``, ``collisions`` (every
         contact episode: the robot ran into something), ``collisions_with_people`` (those of them
