@@ -30,6 +30,7 @@ from missions.camera_use import cameras_read
 from missions.dataflow import check_dataflow
 from missions.inputs import IDENT, bind, declaration, substitute
 from missions.language import MissionSpec, NodeSpec
+from missions.load_checks import load_checks
 from missions.model import Evaluation, InputDeclaration, MissionFile
 from missions.nodes import NodeReader, Scope
 from missions.plugins import PluginError, load_plugin
@@ -269,6 +270,8 @@ def load_mission(
         cameras=cameras, registry=loader.registry,
     )  # fmt: skip
     problems = [*loader.diagnostics, *check_dataflow(mission)]  # every problem at once, not in stages
+    if not problems:
+        problems = load_checks(mission)  # against what the files hold: only a mission whose flow is sound
     if problems:
         raise InputError(problems)
     if cameras is None:  # grab what the nodes read, no more (missions/camera_use.py)
