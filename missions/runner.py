@@ -70,9 +70,11 @@ from drivers.safety.settings import monitor_config
 from maps.store import write_json
 from missions.builder import build_root
 from missions.clocks import WallClock
+from missions.images import DEFAULT_RATE_HZ
 from missions.language import MissionSpec
 from missions.recording import Recorder
 from missions.safety import Interrupted, SafetyMonitor, exit_code
+from missions.summary import declared_headline
 from perception.collision_monitor import CollisionMonitor, MonitorConfig
 
 
@@ -93,7 +95,7 @@ class RunOptions:
     overrun_s: float | None = None  # tick watchdog limit; None: the mission's on a robot, none in simulation
     report_path: Path | None = None
     save_path: Path | None = None
-    progress: bool = False
+    image_rate_hz: float | None = DEFAULT_RATE_HZ  # camera images per second in the recording; None or 0: every frame
     seed: int = 0
     debug: bool = False  # print the traceback of an exception in the tree
 
@@ -194,7 +196,7 @@ class Runner:
         if self.options.save_path is not None:
             self._recorder = Recorder(self.options.save_path, mission=self.mission.name,
                                       recording_id=f"{self.mission.name}-seed{self.options.seed}",
-                                      timeline=self.clock.timeline)
+                                      timeline=self.clock.timeline, image_rate_hz=self.options.image_rate_hz)
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
         self.blackboard.set(SAFETY_KEY.path, self.guard.state)
@@ -203,7 +205,6 @@ class Runner:
         self._drawers = [node for node in self.root.iterate() if isinstance(node, Reports | Draws)]
 
     def _loop(self) -> tuple[str, str]:
-        last_progress = 0.0
         while True:
             stop = self.monitor.stopped_reason
             if stop is not None:
@@ -220,9 +221,6 @@ class Runner:
                 return "FAILURE", self.monitor.fault
             if self.on_tick is not None:
                 self.on_tick(self)
-            if self.options.progress and time.monotonic() - last_progress > 0.2:
-                last_progress = time.monotonic()
-                self._print_progress(now)
             if self.root.status in (Status.SUCCESS, Status.FAILURE):
                 return self.root.status.value, self._outcome_reason()
             self.clock.next_tick(self.period)
@@ -238,8 +236,6 @@ class Runner:
             with contextlib.suppress(Exception):  # the run's outcome matters more than the file
                 self._recorder.log_stop(time_s=self.clock.now(), tick=self.ticks)
                 self._recorder.close()
-        if self.options.progress:
-            sys.stderr.write("\n")
 
     def _result(self, status: str, reason: str) -> RunResult:
         result = RunResult(status, reason, self.ticks, self.clock.now(), signum=self.monitor.signum)
@@ -284,7 +280,8 @@ class Runner:
         if self._recorder is not None:
             self._recorder.log_tick(time_s=self.clock.now(), tick=self.ticks + 1, root=self.root,
                                     odometry=self._get("/robot/odometry"), command=self.last_command,
-                                    observers=self.observers, nodes=self._drawers)
+                                    observers=self.observers, nodes=self._drawers,
+                                    frames=self._get("/perception/frames"))
             self._recorder.draw(Plot("safety/ratio", self.guard.state.ratio))
             for event in self.guard.log.take_new():
                 self._recorder.draw(Event("safety/events", event.line()))
@@ -296,7 +293,7 @@ class Runner:
         except KeyError:
             return None
 
-    def _node_sections(self) -> dict[str, dict[str, Any]]:
+    def _node_sections(self) -> Sections:
         """What the tree's nodes add to the report (a node that fails to say is noted, not fatal)."""
         gathered = Sections()
         for node in self.root.iterate():
@@ -305,7 +302,7 @@ class Runner:
                     gathered.add(node.figures())
             except Exception as exc:  # noqa: BLE001 - the report must be written whatever a node does
                 gathered.sections.setdefault("report_errors", {})[node.name] = describe_exception(exc)
-        return gathered.sections
+        return gathered
 
     def _outcome_reason(self) -> str:
         if self.root.status == Status.SUCCESS:
@@ -317,13 +314,6 @@ class Runner:
             detail = f": {node.feedback_message}" if node.feedback_message else ""
             return f"{node.name} failed{detail}"
         return "mission tree failed"
-
-    def _print_progress(self, now: float) -> None:
-        tip = self.task.tip()
-        active = "" if tip is None else tip.name + (f": {tip.feedback_message}" if tip.feedback_message else "")
-        line = f"[{self.mission.name}] t={now:7.1f} s  tick {self.ticks:6d}  {active}"
-        sys.stderr.write("\r" + line[:110].ljust(110))
-        sys.stderr.flush()
 
     def _report(self, result: RunResult) -> dict[str, Any]:
         mission = self.mission
@@ -343,13 +333,15 @@ class Runner:
             report["sim_time_s"] = round(result.time_s, 6)
         for observer in self.observers:
             report.update(observer.report_sections(mission.evaluation))
-        for name, values in self._node_sections().items():
+        nodes = self._node_sections()
+        for name, values in nodes.sections.items():
             report.setdefault(name, {}).update(values)
         report["safety"] = self.guard.log.summary()
         for device in (self.guard.base, self.robot.ptu):
             sections = getattr(device, "report_sections", None)
             if callable(sections):
                 report.update(sections())
+        report["headline"] = declared_headline([*self.observers, self.robot.base, self.robot.ptu], nodes.headline)
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}

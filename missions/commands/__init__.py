@@ -19,6 +19,8 @@ COMMANDS = (
     "missions.commands.calibrate",
     "missions.commands.doctor",
     "missions.commands.map",
+    "missions.commands.plot",
+    "missions.commands.missions_list",
 )
 
 ENTRY_POINT_GROUP = "bearings.commands"

@@ -8,16 +8,20 @@ from pathlib import Path
 from typing import Any
 
 from behaviours.clock import TickClock
-from drivers.interfaces import Robot
+from drivers.interfaces import KeyboardOpener, Robot
+from drivers.keyboard import TerminalKeys
 from drivers.safety.settings import monitor_config
 from maps.located import validate
 from maps.store import Diagnostic, InputError, output_problem, write_json
-from missions.clocks import Paced, WallClock
+from missions.clocks import Paced, WallClock, paced_when_operated
 from missions.commands.common import add_mission_options, load_from_args, parse_pose, print_input_error
+from missions.images import DEFAULT_RATE_HZ
 from missions.model import RunArguments
 from missions.outputs import prepare_written_files
+from missions.progress import progress_for
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
+from missions.summary import summary_line
 from perception.collision_monitor import MonitorConfig
 from perception.geometry import Pose2D
 from perception.polygons import disc
@@ -26,7 +30,8 @@ DESCRIPTION = """Run a mission until its tree ends in SUCCESS or FAILURE.
 
 Without --robot the mission runs in the built-in simulator (--sim WORLD picks a shipped world by
 name or a world file; the default is an empty plane), as fast as the machine allows unless
---realtime is given. The same seed gives the same run, bit for bit.
+--realtime is given or an operator drives by keys (real time from when a key node first runs).
+The same seed gives the same run, bit for bit.
 
 Every command passes the collision monitor on its way to the base: it stops the robot short of
 what its range sensors see, slows it near obstacles, and crawls when they fall silent (the
@@ -58,12 +63,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="write the run report (JSON) here; a missing folder is created")
     parser.add_argument("--save", type=Path, metavar="F.rrd",
                         help="record the run for the rerun viewer; a missing folder is created")
+    parser.add_argument("--image-rate", type=float, metavar="HZ", default=DEFAULT_RATE_HZ,
+                        help=f"camera images per second and camera in the --save recording, JPEG-encoded "
+                             f"(default {DEFAULT_RATE_HZ:g}; 0: every frame grabbed)")
     parser.add_argument("--max-time", type=float, metavar="S", help="FAILURE after S seconds (sim or wall time)")
     parser.add_argument("--rate", type=float, metavar="HZ", help="tick rate (default: the mission's, else 10)")
     parser.add_argument("--overrun", type=float, metavar="S",
                         help="how far a tick may overrun its period before the watchdog stops the base")
     parser.add_argument("--realtime", action="store_true", help="pace the simulator at wall-clock speed")
     parser.add_argument("--quiet", action="store_true", help="no progress line")
+    parser.add_argument("--progress", action="store_true",
+                        help="print progress even when stderr is not a terminal: a line every few seconds")
     parser.add_argument("--debug", action="store_true", help="print the traceback when a behaviour raises")
     add_mission_options(parser)
     parser.set_defaults(func=run)
@@ -74,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             numbers = _numbers(args)
             _prepare_outputs(args)
-            mission = load_from_args(args.mission, args)
+            mission = load_from_args(args.mission, args, to_run=True)
             prepare_written_files(mission, lambda note: print(f"bearings run: {note}", file=sys.stderr))
             simulation, robot, clock, safety = _open(args, numbers.seed)
         except InputError as exc:
@@ -100,17 +110,25 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
                                  f"{', '.join(robot.cameras) or 'none'})")]))
     options = RunOptions(
         rate_hz=numbers.rate, max_time_s=numbers.max_time, overrun_s=numbers.overrun, report_path=args.report,
-        save_path=args.save, progress=not args.quiet and sys.stderr.isatty(), seed=numbers.seed, debug=args.debug,
+        save_path=args.save, image_rate_hz=numbers.image_rate, seed=numbers.seed, debug=args.debug,
     )  # fmt: skip
-    if args.realtime and simulation is not None:
-        clock = Paced(clock)
-    result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
-                    safety=safety).run()
+    keyboard: KeyboardOpener = TerminalKeys
+    if simulation is not None:  # real time when asked, or from when an operator takes the keyboard
+        clock = Paced(clock, engaged=args.realtime)
+        keyboard = paced_when_operated(TerminalKeys, clock, said=lambda line: print(line, file=sys.stderr))
+    progress = progress_for(mission.name, sys.stderr, asked=args.progress, quiet=args.quiet)
+    try:
+        result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
+                        on_tick=progress, keyboard=keyboard, safety=safety).run()
+    finally:
+        if progress is not None:
+            progress.close()
     clock_name = "sim" if simulation is not None else "wall"
     print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock_name} time, {result.ticks} ticks "
           f"({result.reason})")
-    for line in outcome_lines(result.report):
-        print(line)
+    summary = summary_line(result.report)  # collisions, safety stops, clearance, each capability's headline
+    if summary:
+        print(summary)
     if args.report:
         print(f"report: {args.report}")
     if args.save:
@@ -118,26 +136,9 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
     return result.exit_code
 
 
-def outcome_lines(report: dict[str, Any]) -> list[str]:
-    """The lines after the status: the collision monitor's count, and the ground truth in simulation
-    (collisions and the true minimum clearance first: a run that touched something did not succeed)."""
-    safety = report.get("safety", {})
-    nearest = safety.get("min_range_m")
-    lines = [f"safety: {safety.get('safety_stops', 0)} stops, {safety.get('slowdowns', 0)} slow-downs, "
-             f"{safety.get('bumper_hits', 0)} bumper hits, nearest sensed "
-             f"{'nothing' if nearest is None else f'{nearest:.3f} m'} (sensors: {safety.get('sources', 'none')})"]
-    gt = report.get("ground_truth")
-    if gt:
-        figures = [f"collisions {gt.get('collisions', 0)}"]
-        if gt.get("min_clearance_m") is not None:
-            figures.append(f"min_clearance_m {gt['min_clearance_m']:.3f}")
-        figures += [f"{k} {gt[k]:.3f}" for k in ("trajectory_length_m", "goal_error_m", "path_error_m") if k in gt]
-        lines.append(f"ground truth: {', '.join(figures)}")
-    return lines
-
-
 def _numbers(args: argparse.Namespace) -> RunArguments:
-    given = {"--rate": args.rate, "--max-time": args.max_time, "--overrun": args.overrun, "--seed": args.seed}
+    given = {"--rate": args.rate, "--max-time": args.max_time, "--overrun": args.overrun, "--seed": args.seed,
+             "--image-rate": args.image_rate}
     return validate(RunArguments, {k: v for k, v in given.items() if v is not None}, file="command line")
 
 
