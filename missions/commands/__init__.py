@@ -19,6 +19,7 @@ COMMANDS = (
     "missions.commands.calibrate",
     "missions.commands.doctor",
     "missions.commands.map",
+    "missions.commands.log",
 )
 
 ENTRY_POINT_GROUP = "bearings.commands"
