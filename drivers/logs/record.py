@@ -134,14 +134,15 @@ class SensorLog:
             image, _, _, _ = topics.camera_topics(name, "bearings")
             return [(image, msg.POINT_CLOUD, camera_codec.bearings_message(frame))]
         image, info, right, right_info = topics.camera_topics(name, "compressed")
-        infos = camera_codec.camera_info_messages(frame.camera, frame.stamp, name)
-        out = [(info, msg.CAMERA_INFO, infos[0]),
-               (image, msg.COMPRESSED_IMAGE,
-                camera_codec.compressed_image_message(frame.image, frame.stamp, name, self.images))]
+        # the model with every image, as ROS cameras publish it (a camera without one: images only)
+        infos = camera_codec.camera_info_messages(frame.camera, frame.stamp, name) if frame.camera is not None else []
+        out = [(info, msg.CAMERA_INFO, infos[0])] if infos else []
+        out.append((image, msg.COMPRESSED_IMAGE,
+                    camera_codec.compressed_image_message(frame.image, frame.stamp, name, self.images)))
         if frame.right is not None:
-            out += [(right_info, msg.CAMERA_INFO, infos[-1]),
-                    (right, msg.COMPRESSED_IMAGE, camera_codec.compressed_image_message(
-                        frame.right, frame.stamp, f"{name}_right", self.images))]
+            out += [(right_info, msg.CAMERA_INFO, infos[-1])] if infos else []
+            out.append((right, msg.COMPRESSED_IMAGE, camera_codec.compressed_image_message(
+                frame.right, frame.stamp, f"{name}_right", self.images)))
         return out
 
     def scan_messages(self, scan: RangeScan) -> list[tuple[str, str, dict[str, Any]]]:

@@ -4,11 +4,12 @@
 interfaces: a :class:`~drivers.interfaces.Robot` whose base answers the logged odometry and stall
 flag, whose pan-tilt unit the logged joint state, whose cameras the logged frames, whose range
 source the logged ranges and bumpers, and a keyboard of the logged keys. Its clock
-(:meth:`Replay.clock`, the ``log_time`` timeline) plays the log as the simulator's clock steps the
-world: each tick moves time on by the period and delivers every message logged up to then, so
-the first tick sees what was logged at the log's start and frames arrive as they were logged
-(their rate, their drops: a camera whose frame did not come in since the last grab returns
-None). Messages are read one at a time as time reaches them; nothing is loaded ahead.
+(:meth:`Replay.clock`, timeline ``replay_time``: rerun has a ``log_time`` of its own) plays the
+log as the simulator's clock steps the world: each tick moves time on by the period and delivers
+every message logged up to then, so the first tick sees what was logged at the log's start and
+frames arrive as they were logged (their rate, their drops: a camera whose frame did not come in
+since the last grab returns None). Messages are read one at a time as time reaches them; nothing
+is loaded ahead. Times count from the log's first message.
 
 Open loop: the mission's commands go nowhere. They are counted, and compared with the commands
 the log holds at the same time (the report's ``replay`` section; the rerun recording plots the
@@ -207,7 +208,7 @@ class ReplayClock:
     """The replay's clock: time is ``ticks * period`` after the log's start (no drift), and each
     tick delivers the messages logged up to it; :class:`EndOfLog` when none is left."""
 
-    timeline = "log_time"
+    timeline = "replay_time"
 
     def __init__(self, replay: Replay) -> None:
         self._replay = replay

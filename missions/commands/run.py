@@ -119,7 +119,7 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
     keyboard = simulation.keyboard if isinstance(simulation, Replay) else TerminalKeys  # a replay's: the logged keys
     result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
                     safety=safety, keyboard=keyboard).run()
-    clock_name = {"sim_time": "sim", "log_time": "log"}.get(clock.timeline, "wall")
+    clock_name = {"sim_time": "sim", "replay_time": "log"}.get(clock.timeline, "wall")
     print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock_name} time, {result.ticks} ticks "
           f"({result.reason})")
     for line in outcome_lines(result.report):
