@@ -3,6 +3,9 @@ entries over them, models from files or inline, located errors."""
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import pytest
 
 from drivers.logs import messages as msg
@@ -61,3 +64,13 @@ def test_a_bad_map_is_located(tmp_path):
     path.write_text("- /odom\n")
     with pytest.raises(InputError, match="a topic map is a mapping"):
         load_topic_map(path)
+
+
+def test_the_topic_map_of_the_documentation_loads(tmp_path):
+    page = (Path(__file__).resolve().parents[2] / "docs" / "recorded-data.md").read_text()
+    block = page[page.index("## Replaying other logs"):]
+    (tmp_path / "map.yaml").write_text(re.search(r"```yaml\n(.*?)```", block, re.S).group(1))
+    (tmp_path / "panorama.yaml").write_text("kind: panorama\n")
+    resolved = resolve_topics({}, load_topic_map(tmp_path / "map.yaml"), map_path=tmp_path / "map.yaml")
+    assert resolved.cameras["panorama"].model == PanoramaCamera()
+    assert resolved.cameras["stereo"].right == "/stereo/right/image_raw" and resolved.odometry == "/wheel/odom"
