@@ -59,7 +59,7 @@ import traceback
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import py_trees
 from py_trees.common import Status
@@ -70,7 +70,6 @@ from behaviours.telemetry import Draws, Event, Plot, Reports, Sections
 from drivers.interfaces import STOP, KeyboardOpener, PanTiltCommand, Robot, VelocityCommand
 from drivers.keyboard import TerminalKeys
 from drivers.logs.camera_codec import ImageFormat
-from drivers.logs.record import SensorLog
 from drivers.pioneer_body import BODIES
 from drivers.safety.guarded_base import GuardedBase
 from drivers.safety.settings import monitor_config
@@ -81,6 +80,9 @@ from missions.language import MissionSpec
 from missions.recording import Recorder
 from missions.safety import Interrupted, SafetyMonitor, exit_code
 from perception.collision_monitor import CollisionMonitor, MonitorConfig
+
+if TYPE_CHECKING:
+    from drivers.logs.record import SensorLog
 
 
 class RunObserver(Protocol):
@@ -143,9 +145,11 @@ class Runner:
         self.mission = mission
         self.options = options or RunOptions()
         self.clock: TickClock = clock or WallClock()
-        self.sensor_log = SensorLog(self.options.record_path, images=self.options.record_images) \
-            if self.options.record_path is not None else None
-        if self.sensor_log is not None:  # devices record what they deliver and are sent, inside the monitor
+        self.sensor_log: SensorLog | None = None
+        if self.options.record_path is not None:  # devices record what they deliver and are sent, inside the monitor
+            from drivers.logs.record import SensorLog  # MCAP's libraries load only when a run records
+
+            self.sensor_log = SensorLog(self.options.record_path, images=self.options.record_images)
             robot = self.sensor_log.wrap(robot, self.clock.now)
             keyboard = self.sensor_log.wrap_keyboard(keyboard)
         self.keyboard = keyboard  # opened by a node that drives by keys, when it first runs

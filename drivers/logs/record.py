@@ -37,6 +37,7 @@ from drivers.interfaces import (
 from drivers.logs import camera_codec, codec, topics
 from drivers.logs import messages as msg
 from drivers.logs.camera_codec import ImageFormat
+from drivers.logs.source import first_line
 from drivers.logs.writer import LogWriter
 from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
@@ -116,7 +117,7 @@ class SensorLog:
     def failed(self, topic: str, exc: Exception) -> None:
         self.errors += 1
         if not self.first_error:
-            self.first_error = f"{topic}: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+            self.first_error = f"{topic}: {first_line(exc)}"
 
     def summary(self) -> dict[str, Any]:
         """The report's ``record`` section."""

@@ -29,7 +29,7 @@ from typing import Any
 
 from drivers.interfaces import KeySource, PanTiltState, Robot, VelocityCommand
 from drivers.logs import codec
-from drivers.logs.replay_devices import ReplayCamera, ReplayRanges
+from drivers.logs.replay_devices import ReplayCamera, ReplayRanges, describe_problem
 from drivers.logs.source import LogError, LogMessage, LogReader
 from drivers.logs.topics import Topics
 from perception.geometry import Pose2D
@@ -113,7 +113,7 @@ class Replay:
                     handler(message)
                 except (ValueError, KeyError, TypeError, IndexError) as exc:
                     raise LogError(f"{self.path}: {message.topic} at {self.log_seconds(message.log_ns):.3f} s: "
-                                   f"{exc}") from None
+                                   f"{describe_problem(exc)}") from None
 
     def _peek(self) -> LogMessage | None:
         if self._next is None and not self.exhausted:

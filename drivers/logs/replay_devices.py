@@ -95,9 +95,9 @@ class ReplayCamera:
         self._pending = None
         try:
             frame = self._decode(pending, stamp, right)
-        except ValueError as exc:
+        except (ValueError, KeyError, TypeError, IndexError) as exc:
             raise LogError(f"{replay.path}: {pending.topic} at {replay.log_seconds(pending.log_ns):.3f} s: "
-                           f"{exc}") from None
+                           f"{describe_problem(exc)}") from None
         self.delivered += 1
         return frame
 
@@ -194,3 +194,8 @@ def _sensor(mounting: codec.Mounting, message: dict[str, Any] | None) -> RangeSe
     if message is None:
         return RangeSensor(mounting.x, mounting.y, mounting.heading)
     return codec.range_sensor(mounting, message)
+
+
+def describe_problem(exc: Exception) -> str:
+    """What is wrong with a message, in words (a missing field says which)."""
+    return f"the message has no field {exc}" if isinstance(exc, KeyError) else str(exc)

@@ -7,14 +7,14 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from drivers.logs.reader import file_size, open_log
 from drivers.logs.source import LogContents, LogError, LogReader
-from drivers.logs.topics import Topics
 from maps.store import InputError
 from missions.commands.common import EXIT_INVALID, EXIT_OK, add_mission_options, load_from_args, print_input_error
-from missions.log_check import Needs, check_log, mission_needs, open_topics, rate
+
+if TYPE_CHECKING:
+    from drivers.logs.topics import Topics
 
 DESCRIPTION = """Sensor logs: MCAP files that 'bearings run --record' writes, ROS 2 bag folders (sqlite3 or
 MCAP storage) and ROS 1 bags.
@@ -52,6 +52,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run_info(args: argparse.Namespace) -> int:
+    from drivers.logs.reader import open_log  # the log libraries load when a log command runs
+    from missions.log_check import open_topics
+
     try:
         reader = open_log(args.log)
     except LogError as exc:
@@ -73,6 +76,9 @@ def run_info(args: argparse.Namespace) -> int:
 
 
 def run_check(args: argparse.Namespace) -> int:
+    from drivers.logs.reader import open_log  # the log libraries load when a log command runs
+    from missions.log_check import check_log, mission_needs, open_topics
+
     try:
         mission = load_from_args(args.mission, args)
         reader = open_log(args.log)
@@ -102,6 +108,9 @@ def run_check(args: argparse.Namespace) -> int:
 
 def describe(reader: LogReader, topics: Topics) -> dict[str, Any]:
     """What ``bearings log info`` says: the file, its topics, and the cameras found with their models."""
+    from drivers.logs.reader import file_size
+    from missions.log_check import Needs, check_log
+
     contents = reader.contents()
     needs = Needs(cameras=tuple(topics.cameras), ptu=True, ranges=True)
     findings = {f.role: f for f in check_log(reader.path, topics, contents, needs)}
@@ -152,6 +161,8 @@ def info_lines(summary: dict[str, Any]) -> list[str]:
 
 
 def _rate(contents: LogContents, count: int) -> float | None:
+    from missions.log_check import rate
+
     value = rate(contents, count)
     return round(value, 2) if value else None
 

@@ -11,7 +11,6 @@ from behaviours.clock import TickClock
 from drivers.interfaces import Robot
 from drivers.keyboard import TerminalKeys
 from drivers.logs.camera_codec import parse_image_format
-from drivers.logs.replay import Replay
 from drivers.pioneer_body import BODIES
 from drivers.safety.settings import monitor_config
 from maps.located import validate
@@ -116,7 +115,7 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
     )  # fmt: skip
     if args.realtime and simulation is not None:
         clock = Paced(clock)
-    keyboard = simulation.keyboard if isinstance(simulation, Replay) else TerminalKeys  # a replay's: the logged keys
+    keyboard = simulation.keyboard if args.replay is not None else TerminalKeys  # a replay's: the logged keys
     result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
                     safety=safety, keyboard=keyboard).run()
     clock_name = {"sim_time": "sim", "replay_time": "log"}.get(clock.timeline, "wall")
