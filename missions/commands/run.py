@@ -30,6 +30,10 @@ Without --robot the mission runs in the built-in simulator (--sim WORLD picks a 
 name or a world file; the default is an empty plane), as fast as the machine allows unless
 --realtime is given. The same seed gives the same run, bit for bit.
 
+--record F.mcap records every sensed input and command as ROS 2 messages (MCAP: Foxglove and the
+ROS 2 tools open it); --replay LOG runs the mission on such a recording, or on a ROS 2 or ROS 1
+bag, instead of a robot: open loop, its commands go nowhere (docs/recorded-data.md).
+
 Every command passes the collision monitor on its way to the base: it stops the robot short of
 what its range sensors see, slows it near obstacles, and crawls when they fall silent (the
 robot profile's safety: section; in the simulator, zones around the world's robot disc). The
@@ -59,8 +63,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="with --replay: which topics of the log are the odometry, cameras, ... (default: "
                         "the names --record writes)")
     parser.add_argument("--record", type=Path, metavar="F.mcap",
-                        help="record every sensed input and command as ROS 2 messages in MCAP (Foxglove, ros2 bag, "
-                        "--replay read it); a missing folder is created")
+                        help="record every sensed input and command as ROS 2 messages in MCAP (Foxglove, the ROS 2 "
+                        "tools and --replay read it); a missing folder is created")
     parser.add_argument("--record-images", type=_image_format, default="jpeg", metavar="jpeg[:Q]|png",
                         help="how --record compresses images: jpeg (quality 90, or Q) or png (lossless: a replay "
                         "sees the very pixels); default jpeg")
@@ -158,7 +162,7 @@ def _numbers(args: argparse.Namespace) -> RunArguments:
 
 
 def _prepare_outputs(args: argparse.Namespace) -> None:
-    """Check --report and --save before anything runs; create a missing folder (and say so)."""
+    """Check --report, --save and --record before anything runs; create a missing folder (and say so)."""
     problems = []
     for option, path in (("--report", args.report), ("--save", args.save), ("--record", args.record)):
         if path is None:
