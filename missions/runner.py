@@ -33,6 +33,11 @@ tick ``/robot/safety`` holds the monitor's state, the recording gets an event li
 intervention, and the report a ``safety`` section (stops and slow-downs counted as episodes,
 bumper hits, the nearest range, the first events).
 
+With ``record_path`` (``--record``) every device of the robot records what it delivers and what
+it is sent (:class:`~drivers.logs.record.SensorLog`, inside the collision monitor: the base's
+commands are the ones sent), the tree's own command and the clock once per tick; the file is
+closed on every way the run ends and the report gets a ``record`` section.
+
 Capabilities add to the report and the recording without touching the runner: any node of the
 tree may report ``figures()`` (named values, gathered into the report's sections: ``ltmap``,
 ``roadmap``, ``exploration``; numbers are plotted in the recording too) and ``drawings()``
@@ -54,7 +59,7 @@ import traceback
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import py_trees
 from py_trees.common import Status
@@ -64,6 +69,7 @@ from behaviours.keys import COMMAND_KEYS, SAFETY_KEY, input_key
 from behaviours.telemetry import Draws, Event, Plot, Reports, Sections
 from drivers.interfaces import STOP, KeyboardOpener, PanTiltCommand, Robot, VelocityCommand
 from drivers.keyboard import TerminalKeys
+from drivers.logs.camera_codec import ImageFormat
 from drivers.pioneer_body import BODIES
 from drivers.safety.guarded_base import GuardedBase
 from drivers.safety.settings import monitor_config
@@ -76,6 +82,9 @@ from missions.recording import Recorder
 from missions.safety import Interrupted, SafetyMonitor, exit_code
 from missions.summary import declared_headline
 from perception.collision_monitor import CollisionMonitor, MonitorConfig
+
+if TYPE_CHECKING:
+    from drivers.logs.record import SensorLog
 
 
 class RunObserver(Protocol):
@@ -98,6 +107,8 @@ class RunOptions:
     image_rate_hz: float | None = DEFAULT_RATE_HZ  # camera images per second in the recording; None or 0: every frame
     seed: int = 0
     debug: bool = False  # print the traceback of an exception in the tree
+    record_path: Path | None = None  # --record: every sensed input and command, as ROS 2 messages in MCAP
+    record_images: ImageFormat = field(default_factory=ImageFormat)
 
 
 @dataclass
@@ -134,9 +145,16 @@ class Runner:
         safety: MonitorConfig | None = None,
     ) -> None:
         self.mission = mission
-        self.keyboard = keyboard  # opened by a node that drives by keys, when it first runs
         self.options = options or RunOptions()
         self.clock: TickClock = clock or WallClock()
+        self.sensor_log: SensorLog | None = None
+        if self.options.record_path is not None:  # devices record what they deliver and are sent, inside the monitor
+            from drivers.logs.record import SensorLog  # MCAP's libraries load only when a run records
+
+            self.sensor_log = SensorLog(self.options.record_path, images=self.options.record_images)
+            robot = self.sensor_log.wrap(robot, self.clock.now)
+            keyboard = self.sensor_log.wrap_keyboard(keyboard)
+        self.keyboard = keyboard  # opened by a node that drives by keys, when it first runs
         config = safety or monitor_config(None, BODIES["p3dx"].footprint)
         self.guard = GuardedBase(robot.base, CollisionMonitor(config), robot.ranges, self.clock.now)
         self.robot = dataclasses.replace(robot, base=self.guard)  # the tree and the stops see the guarded base
@@ -197,6 +215,8 @@ class Runner:
             self._recorder = Recorder(self.options.save_path, mission=self.mission.name,
                                       recording_id=f"{self.mission.name}-seed{self.options.seed}",
                                       timeline=self.clock.timeline, image_rate_hz=self.options.image_rate_hz)
+        if self.sensor_log is not None:
+            self.sensor_log.open(mission=self.mission.name, timeline=self.clock.timeline, rate_hz=self.rate_hz)
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
         self.blackboard.set(SAFETY_KEY.path, self.guard.state)
@@ -229,6 +249,8 @@ class Runner:
         """Stop everything, halt the tree, record the stop (runs whatever happened)."""
         self.robot.stop_all()  # the last command sent is always a stop
         self.last_command = STOP
+        if self.sensor_log is not None:
+            self.sensor_log.close()
         with contextlib.suppress(Exception):  # halting must not mask the outcome
             if self.root.status == Status.RUNNING:
                 self.root.stop(Status.INVALID)
@@ -251,6 +273,8 @@ class Runner:
     def _emergency_exit(self, signum: int) -> None:
         """Called by the monitor when a signal came and the loop is stuck: report, then end the process."""
         self.robot.stop_all()
+        if self.sensor_log is not None:
+            self.sensor_log.close()
         with contextlib.suppress(Exception):
             reason = f"{self.monitor.stopped_reason}; the tree did not return, the process was ended"
             self._result("INTERRUPTED", reason)
@@ -273,6 +297,8 @@ class Runner:
         self.robot.base.drive(asked.v, asked.w)  # through the collision monitor
         self.last_command = VelocityCommand(asked.v * self.guard.state.ratio, asked.w * self.guard.state.ratio)
         self.blackboard.set(SAFETY_KEY.path, self.guard.state)
+        if self.sensor_log is not None:
+            self.sensor_log.tick(asked)
         ptu_command = self._get("/ptu/command")
         if self.robot.ptu is not None and isinstance(ptu_command, PanTiltCommand) and ptu_command != self._last_ptu:
             self.robot.ptu.move(ptu_command.pan, ptu_command.tilt, ptu_command.speed)
@@ -337,6 +363,8 @@ class Runner:
         for name, values in nodes.sections.items():
             report.setdefault(name, {}).update(values)
         report["safety"] = self.guard.log.summary()
+        if self.sensor_log is not None:
+            report["record"] = self.sensor_log.summary()
         for device in (self.guard.base, self.robot.ptu):
             sections = getattr(device, "report_sections", None)
             if callable(sections):

@@ -21,6 +21,7 @@ COMMANDS = (
     "missions.commands.map",
     "missions.commands.plot",
     "missions.commands.missions_list",
+    "missions.commands.log",
 )
 
 ENTRY_POINT_GROUP = "bearings.commands"
