@@ -38,10 +38,11 @@ def taught(tmp_path_factory) -> Path:
     """A live teach recorded losslessly, and its replay through the same mission."""
     folder = tmp_path_factory.mktemp("taught")
     assert run("teach_route", "--sim", "lab", "--set", ROUTE, "--set", f"map={folder / 'live.ltmap'}",
-               "--record", str(folder / "run.mcap"), "--record-images", "png",
+               "--output-dir", str(folder), "--record", str(folder / "run.mcap"), "--record-images", "png",
                "--report", str(folder / "live.json")) == 0
     assert run("teach_route", "--replay", str(folder / "run.mcap"), "--set", ROUTE,
-               "--set", f"map={folder / 'replay.ltmap'}", "--report", str(folder / "replay.json")) == 0
+               "--set", f"map={folder / 'replay.ltmap'}", "--output-dir", str(folder),
+               "--report", str(folder / "replay.json")) == 0
     return folder
 
 
@@ -68,7 +69,8 @@ def test_the_replay_commanded_what_the_live_run_did(taught):
 
 def test_the_replayed_map_takes_follow_route_home(taught):
     report = taught / "follow.json"
-    assert run("follow_route", "--sim", "lab", "--set", f"map={taught / 'replay.ltmap'}", "--report", str(report)) == 0
+    assert run("follow_route", "--sim", "lab", "--set", f"map={taught / 'replay.ltmap'}", "--output-dir", str(taught),
+               "--report", str(report)) == 0
     final = json.loads(report.read_text())["ground_truth"]["final_pose"]
     assert np.hypot(final["x"] - 1.5, final["y"] - 1.5) < 0.25  # home: the lab's start
 
@@ -153,7 +155,7 @@ def test_a_ros2_bag_of_simulator_frames_replays_through_teach_route_to_a_map(tmp
     report = tmp_path / "report.json"
     assert main(["log", "check", str(bag), "teach_route", "--topics", str(topic_map)]) == 0
     assert run("teach_route", "--replay", str(bag), "--topics", str(topic_map), "--set", "route=[1.0, 0.0]",
-               "--set", f"map={tmp_path / 'bag.ltmap'}", "--report", str(report)) == 0, \
+               "--set", f"map={tmp_path / 'bag.ltmap'}", "--output-dir", str(tmp_path), "--report", str(report)) == 0, \
         json.loads(report.read_text())["reason"]
     taught = load_ltmap(tmp_path / "bag.ltmap")
     assert taught.viewframe_count >= 3 and taught.landmark_count > 300
@@ -167,11 +169,13 @@ def test_a_route_taught_by_keys_replays_with_the_logged_keys(tmp_path):
     keys = FakeKeys([["up"]] * 25 + [["left"]] * 8 + [["up"]] * 10 + [["q"]])
     sets = {"camera": "landmarks", "drive": "keyboard", "map": str(tmp_path / "live.ltmap")}
     sim = Simulation.load("lab", seed=2)
-    result = Runner(load_mission("teach_route", overrides=sets), sim.robot, clock=sim.clock(), observers=[sim],
+    mission = load_mission("teach_route", overrides=sets, output_dir=tmp_path)
+    result = Runner(mission, sim.robot, clock=sim.clock(), observers=[sim],
                     options=RunOptions(record_path=tmp_path / "run.mcap"), keyboard=lambda: keys).run()
     assert result.status == "SUCCESS", result.reason
     assert run("teach_route", "--replay", str(tmp_path / "run.mcap"), "--set", "camera=landmarks",
-               "--set", "drive=keyboard", "--set", f"map={tmp_path / 'replay.ltmap'}") == 0
+               "--set", "drive=keyboard", "--set", f"map={tmp_path / 'replay.ltmap'}",
+               "--output-dir", str(tmp_path)) == 0
     live, replayed = load_ltmap(tmp_path / "live.ltmap"), load_ltmap(tmp_path / "replay.ltmap")
     assert replayed.summary() == live.summary() and live.viewframe_count >= 3
     assert np.allclose(replayed.bearings, live.bearings, rtol=0, atol=1e-12)
