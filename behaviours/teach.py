@@ -46,8 +46,8 @@ class LearnRoute(BearingsDecorator):
     """
 
     PATH = InputPort("path", str, "", literal_only=True, doc="the LT-map file written at the end; empty: not saved")
-    THRESHOLD = InputPort("threshold", float, DEFAULT_THRESHOLD, unit="rad^2", minimum=1e-9, literal_only=True,
-                          doc="eq. 1: a new viewframe when delta_t passes it")
+    THRESHOLD = InputPort("threshold", float, DEFAULT_THRESHOLD, minimum=1e-12, literal_only=True,
+                          doc="eq. 1: a new viewframe when delta_t passes it (1.085e-6: a 3 deg bearing change)")
     BUDGET = InputPort("budget", int, 0, unit="B", minimum=0, literal_only=True,
                        doc="memory budget, pruned online while teaching; 0: none")
     MIN_LANDMARKS = InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0, literal_only=True,

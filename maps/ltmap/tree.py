@@ -69,10 +69,9 @@ from maps.ltmap.matching import Viewframe, ViewframeCache, match_viewframe, stac
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS, PruneReport, PruneStep, cut_lowest_level, follow
 from perception.matching import LandmarkMatches
 from perception.observation import Observation
-from perception.similarity import bearing_angles
+from perception.similarity import DEFAULT_SCALE, bearing_angles, default_threshold
 
-# eq. 1 threshold (rad^2; mean Pseudo-Huber cost, delta 2 deg): about 3 deg of mean bearing change
-DEFAULT_THRESHOLD = 1.0e-3
+DEFAULT_THRESHOLD = default_threshold()  # eq. 1: the cost of a 3 deg bearing change (1.085e-6)
 NO_GATE = float("inf")  # share every tracked landmark, whatever its bearing now
 
 
@@ -173,12 +172,14 @@ class LandmarkTree:
     path of route following, cached per viewframe).
     """
 
-    def __init__(self, kind: str, *, threshold: float = DEFAULT_THRESHOLD) -> None:
+    def __init__(self, kind: str, *, threshold: float = DEFAULT_THRESHOLD, scale: float = DEFAULT_SCALE) -> None:
         check_kind(kind)
-        if not (np.isfinite(threshold) and threshold > 0):
-            raise ValueError(f"threshold must be a positive number, got {threshold}")
+        for name, value in (("threshold", threshold), ("scale", scale)):
+            if not (np.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a positive number, got {value}")
         self.kind = kind
         self.threshold = float(threshold)
+        self.scale = float(scale)  # eq. 1's b: delta_t against ``threshold`` is measured with it
         self._parent: list[int] = []
         self._leaves: list[int] = []
         self._rows = _Rows(np.zeros(0, dtype=np.int64), np.zeros((0, 3), dtype=BEARING_DTYPE), empty_data(kind))
@@ -431,7 +432,7 @@ class LandmarkTree:
 
     def copy(self) -> LandmarkTree:
         """An independent copy (its own arrays and cache)."""
-        twin = LandmarkTree(self.kind, threshold=self.threshold)
+        twin = LandmarkTree(self.kind, threshold=self.threshold, scale=self.scale)
         twin._parent, twin._leaves, twin._rows = list(self._parent), list(self._leaves), self._rows.copy()
         return twin
 
@@ -458,10 +459,10 @@ class LandmarkTree:
         }
 
     @classmethod
-    def from_arrays(cls, arrays: Mapping[str, np.ndarray], *, kind: str, threshold: float = DEFAULT_THRESHOLD
-                    ) -> LandmarkTree:
+    def from_arrays(cls, arrays: Mapping[str, np.ndarray], *, kind: str, threshold: float = DEFAULT_THRESHOLD,
+                    scale: float = DEFAULT_SCALE) -> LandmarkTree:
         """The map :meth:`to_arrays` describes; ``ValueError`` naming the first inconsistency."""
-        tree = cls(kind, threshold=threshold)
+        tree = cls(kind, threshold=threshold, scale=scale)
         checked = checked_arrays(arrays, kind)
         node = np.repeat(np.arange(len(checked.node_parent), dtype=np.int64), checked.node_size)
         tree._parent, tree._leaves = [int(p) for p in checked.node_parent], [int(v) for v in checked.viewframe_leaf]
