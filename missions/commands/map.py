@@ -17,6 +17,7 @@ from maps.ltmap.file import load_ltmap, save_ltmap
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
 from maps.store import InputError
 from missions.commands.common import EXIT_INVALID, EXIT_OK, fail
+from perception.similarity import angle_of_cost
 
 UNITS = {"": 1, "b": 1, "kb": 10**3, "mb": 10**6, "gb": 10**9, "kib": 2**10, "mib": 2**20, "gib": 2**30}
 MAX_BUDGET = 2**40  # 1 TiB: far above any map; a larger "budget" is a typo
@@ -92,6 +93,7 @@ def run_info(args: argparse.Namespace) -> int:
     except InputError as exc:
         return fail("map", str(exc.diagnostics[0]))
     summary = tree.summary()
+    change = math.degrees(angle_of_cost(summary.threshold, tree.scale))
     if args.json:
         print(json.dumps({"file": args.file, "landmark_kind": summary.kind, "viewframes": summary.viewframes,
                           "landmarks": summary.landmarks, "nodes": summary.nodes, "height": summary.height,
@@ -105,7 +107,7 @@ def run_info(args: argparse.Namespace) -> int:
         ("height", summary.height),
         ("bytes", f"{summary.memory_bytes} ({summary.memory_bytes / 1024:.1f} KiB)"),
         ("per level", " ".join(str(n) for n in summary.landmarks_per_level) + "  (root first)"),
-        ("threshold", f"{summary.threshold:g} rad^2 (eq. 1)"),
+        ("threshold", f"{summary.threshold:g} (eq. 1: a {change:.1f} deg bearing change)"),
     ]
     print(args.file)
     for name, value in rows:
