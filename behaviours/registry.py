@@ -46,7 +46,7 @@ BUILTIN_MODULES = (
     *(f"behaviours.roadmap.{m}" for m in ("targets", "calibration", "room", "coverage", "travel", "scan", "homing",
                                           "graph", "navigate")),
     # exploration with the stereo pair on the pan-tilt unit
-    "behaviours.localise", "behaviours.exploration", "behaviours.follow_path", "behaviours.gaze",
+    *(f"behaviours.exploration.{m}" for m in ("localise", "map_stereo", "select_goal", "follow_path", "gaze")),
 )  # fmt: skip
 _MARK = "__bearings_node_type__"
 

@@ -1,11 +1,11 @@
 """ARCOS / P2OS packet codec for Pioneer bases: pure functions, bytes in and values out.
 
 Nothing here touches a port, a thread or a clock; :mod:`drivers.pioneer` does the I/O and the
-test emulator speaks through the same functions, so both ends agree on every byte. The facts
-come from ``../shared/PROTOCOLS.md`` (checked against ARIA/AriaCoda and p2os):
+test emulator speaks through the same functions, so both ends agree on every byte. The facts,
+with the public source of each, are in ``docs/protocols.md``:
 
 - a packet is ``FA FB | N | payload | CK_hi CK_lo`` where ``N = len(payload) + 2`` (an
-  unsigned byte) and the first payload byte is the command number or the packet type;
+  unsigned byte, so up to 255) and the first payload byte is the command number or the packet type;
 - the checksum adds the payload's big-endian byte pairs modulo 2**16 and XORs an odd last byte;
 - data integers in a payload are little-endian; a command argument is ``0x3B`` + uint16 (>= 0),
   ``0x1B`` + abs value uint16 (< 0), or ``0x2B`` + length + characters (+ NUL, as ARIA sends).
@@ -26,7 +26,7 @@ from enum import IntEnum
 
 HEADER = b"\xfa\xfb"
 MIN_COUNT = 3  # N of the shortest packet: a command byte and the two checksum bytes
-MAX_COUNT = 200  # "packets stay under 200 bytes"; a larger N is garbage and is skipped at once
+MAX_COUNT = 255  # N is one unsigned byte and ARIA's receiver takes any value of it (docs/protocols.md)
 ARG_INT, ARG_NINT, ARG_STR = 0x3B, 0x1B, 0x2B
 UINT16_MAX = 0xFFFF
 
@@ -125,7 +125,10 @@ class PacketReader:
 
     Bytes before a header are skipped; a count outside ``MIN_COUNT..MAX_COUNT`` or a failed
     checksum drops only the first header byte, so a real packet that begins inside a bogus one is
-    still found. A torn packet waits in the buffer for the rest of its bytes.
+    still found. A torn packet waits in the buffer for the rest of its bytes, unless a complete
+    packet with a good checksum already starts inside it: then the waiting one was a corrupt count
+    (any count up to 255 is legal, so a corrupt one would otherwise hold back up to 255 bytes of
+    good packets behind it).
     """
 
     def __init__(self) -> None:
@@ -155,7 +158,13 @@ class PacketReader:
                 del buf[:1]
                 continue
             if len(buf) < count + 3:
-                break
+                later = _complete_packet_after(buf)
+                if later < 0:
+                    break
+                self.stats.bad_lengths += 1
+                self.stats.skipped_bytes += later
+                del buf[:later]
+                continue
             payload = bytes(buf[3 : count + 1])
             if checksum(payload) != int.from_bytes(buf[count + 1 : count + 3], "big"):
                 self.stats.bad_checksums += 1
@@ -176,6 +185,20 @@ class PacketReader:
         self._buffer.clear()
 
 
+def _complete_packet_after(buf: bytearray) -> int:
+    """Where, after the first byte, a complete packet with a good checksum starts in ``buf``; -1 if none."""
+    at = buf.find(HEADER, 1)
+    while at > 0:
+        if len(buf) >= at + 3:
+            count = buf[at + 2]
+            end = at + count + 3
+            if MIN_COUNT <= count <= MAX_COUNT and len(buf) >= end and \
+                    checksum(bytes(buf[at + 3 : end - 2])) == int.from_bytes(buf[end - 2 : end], "big"):
+                return at
+        at = buf.find(HEADER, at + 1)
+    return -1
+
+
 # -- client commands -------------------------------------------------------------------------------
 def encode_command(command: int, arg: int | str | bytes | None = None) -> bytes:
     """A complete packet for ``command`` with an optional integer or string argument."""
@@ -192,7 +215,7 @@ def encode_command(command: int, arg: int | str | bytes | None = None) -> bytes:
         payload += bytes([ARG_INT if arg >= 0 else ARG_NINT]) + abs(arg).to_bytes(2, "little")
     else:
         text = arg.encode("latin-1") if isinstance(arg, str) else bytes(arg)
-        if len(text) > MAX_COUNT - 7:
+        if len(text) > MAX_COUNT - 6:  # N = command + marker + length + text + NUL + 2 checksum bytes
             raise PacketError(f"string argument of {len(text)} bytes is too long")
         payload += bytes([ARG_STR, len(text)]) + text + b"\x00"
     return frame(bytes(payload))
@@ -339,7 +362,7 @@ class Sip:
 
     @property
     def rot_vel(self) -> int | None:
-        """Rotational velocity reported by newer firmware (robot units), or None."""
+        """Rotational velocity reported by newer firmware (tenths of a deg/s, ROTVEL), or None."""
         return int.from_bytes(self.extra[3:5], "little", signed=True) if len(self.extra) >= 5 else None
 
 
@@ -386,17 +409,20 @@ _CONFIG_FIELDS: tuple[tuple[str, str], ...] = (
     ("stall_count", "H"), ("joy_vel", "H"), ("joy_rot_vel", "H"), ("rot_vel_max", "H"),
     ("trans_vel_max", "H"), ("rot_accel", "H"), ("rot_decel", "H"), ("rot_kp", "H"), ("rot_kv", "H"),
     ("rot_ki", "H"), ("trans_accel", "H"), ("trans_decel", "H"), ("trans_kp", "H"), ("trans_kv", "H"),
-    ("trans_ki", "H"),
+    ("trans_ki", "H"), ("front_bumps", "B"), ("rear_bumps", "B"), ("charger", "B"), ("sonar_cycle", "B"),
+    ("reset_baud", "B"), ("gyro_type", "B"), ("drift_factor", "h"), ("aux2_baud", "B"), ("aux3_baud", "B"),
+    ("ticks_mm", "H"), ("shutdown_voltage", "H"), ("firmware", "s"),
 )
+RESET_BAUD_ALLOWED = 2  # the config packet's "reset baud" field: the robot takes HOSTBAUD
 
 
 @dataclass(frozen=True, slots=True)
 class RobotConfig:
-    """The fields of a config packet that this driver reports (later fields are kept raw).
+    """The fields of a config packet that this driver reads (later fields are kept raw).
 
     Velocities in mm/s and deg/s, accelerations in mm/s^2 and deg/s^2, ``watchdog`` in ms,
-    ``low_battery`` in decivolts, ``sip_cycle`` in ms; ``missing`` lists fields an older or
-    shorter packet did not carry.
+    ``low_battery`` in decivolts, ``sip_cycle`` in ms, ``reset_baud`` 2 when the robot accepts
+    HOSTBAUD; ``missing`` lists fields an older or shorter packet did not carry.
     """
 
     values: dict[str, int | str] = field(default_factory=dict)
@@ -405,6 +431,11 @@ class RobotConfig:
 
     def get(self, name: str, default: int | str | None = None) -> int | str | None:
         return self.values.get(name, default)
+
+    @property
+    def allows_hostbaud(self) -> bool:
+        """The robot takes a HOSTBAUD command (ARIA switches only then)."""
+        return self.values.get("reset_baud") == RESET_BAUD_ALLOWED
 
 
 def decode_config(payload: bytes) -> RobotConfig:
@@ -448,7 +479,8 @@ def encode_config(values: dict[str, int | str], rest: bytes = b"") -> bytes:
 # -- units per model -------------------------------------------------------------------------------
 @dataclass(frozen=True, slots=True)
 class ModelParams:
-    """ARIA's conversion factors and limits of one robot model."""
+    """ARIA's conversion factors and limits of one robot model (from ARIA's ``params/<subclass>.p``;
+    the table with its sources is in docs/protocols.md)."""
 
     name: str
     dist_conv: float  # mm per position unit
@@ -530,3 +562,13 @@ class Odometry:
             self.theta += theta_delta(self._last[2], raw[2]) * self.params.angle_conv
         self._last = raw
         return self.x, self.y, self.theta
+
+
+def measured_velocity(sip: Sip, params: ModelParams) -> tuple[float, float]:
+    """``(v mm/s, w deg/s)`` the robot reports: v the mean wheel speed; w its ROTVEL (tenths of a
+    deg/s) when the SIP carries one, else from the wheel speed difference (ARIA's
+    ``ArRobot::processMotorPacket``: ``radToDeg((right - left) / 2 * DiffConvFactor)``)."""
+    left, right = sip.left_vel * params.vel_conv, sip.right_vel * params.vel_conv
+    rot_vel = sip.rot_vel
+    w = rot_vel / 10.0 if rot_vel is not None else math.degrees((right - left) / 2.0 * params.diff_conv)
+    return (left + right) / 2.0, w

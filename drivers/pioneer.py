@@ -1,10 +1,14 @@
 """Pioneer 3-DX / 3-AT base over ARCOS (pyserial): implements :class:`drivers.interfaces.Base`.
 
-``open_base(PioneerSettings(port="/dev/ttyUSB0", model="p3dx"))`` opens the port (any pyserial
-URL: ``socket://localhost:8101`` reaches MobileSim/AMRISim), runs the ARCOS connection sequence
-(SYNC0-2, restarting at SYNC0 on anything out of sequence; CLOSE first if the robot is still
-open from an earlier session; OPEN; CONFIG; SONAR; ENABLE 1), waits for the first SIP, and starts
-one I/O thread. That thread alone reads the port: it parses SIPs into an immutable
+``open_base(PioneerSettings(port="/dev/ttyUSB0"))`` opens the port (any pyserial URL:
+``socket://localhost:8101`` reaches MobileSim/AMRISim) and runs the connection sequence as ARIA
+does (docs/protocols.md): SYNC0-2, restarting at SYNC0 on anything out of sequence (CLOSE first if
+the robot is still open from an earlier session; after two silent tries on a serial device, CLOSE
+at every speed, for a robot left at another speed); the conversion factors of the subclass the
+robot reports in SYNC2 (``model_override`` may force others, and says so); a pause of one SIP
+cycle, OPEN; CONFIG; HOSTBAUD to ``switch_baud`` when the config packet allows it (back to
+``baud`` if nothing answers at the new speed within 0.9 s); SONAR; ENABLE 1. It waits for the
+first SIP and starts one I/O thread. That thread alone reads the port: it parses SIPs into an immutable
 :class:`BaseStatus`, re-sends the current VEL/RVEL every ``resend_period`` (<= 0.5 s, so the
 robot's 2 s watchdog never fires while the link is up), and watches for faults. ``drive()``,
 ``odometry()`` and ``stalled()`` only swap or read Python objects and return at once.
@@ -18,13 +22,15 @@ Faults (see also :mod:`drivers.common`):
   ``reconnect_timeout`` first; meanwhile the pose is held (its stamp ages) and commands are
   dropped, and after reconnecting the base waits for a fresh ``drive()``.
 - ``stop()`` writes STOP, VEL 0 and RVEL 0 from the calling thread at once (it does not wait for
-  the I/O thread) and never raises; ``close()`` stops, disables the motors (ENABLE 0) and sends
-  CLOSE. Bases still open when the interpreter exits are closed by an ``atexit`` hook.
+  the I/O thread) and never raises; ``close()`` stops, disables the motors (ENABLE 0), pauses one
+  SIP cycle and sends CLOSE. Bases still open when the interpreter exits are closed by an
+  ``atexit`` hook.
 - no ``drive()`` call for ``command_timeout`` while moving (a stuck tick loop): the thread
   commands zero velocity itself; the next ``drive()`` resumes (``deadman_stops`` counts these).
 
 The odometry frame starts at the pose of the first SIP (0, 0, 0) and stays continuous across
-the robot's 15-bit position wrap-around and across reconnections.
+the robot's 15-bit position wrap-around and across reconnections. The measured turn rate is the
+SIP's ROTVEL when the firmware sends it, else it is derived from the wheel speeds.
 """
 
 from __future__ import annotations
@@ -38,58 +44,22 @@ import time
 import weakref
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any
 
 import serial
-from pydantic import BaseModel, ConfigDict, Field
 
 from drivers import arcos
-from drivers.arcos import Command, Identity, ModelParams, Odometry, PacketReader, RobotConfig, Sip
-from drivers.common import DriverFault, Stamp, build_settings, monotonic_stamp, quantity
+from drivers.arcos import Command, Identity, ModelParams, Odometry, RobotConfig, Sip
+from drivers.arcos_port import ArcosPort
+from drivers.common import DriverFault, Stamp, build_settings, monotonic_stamp
+from drivers.pioneer_settings import ModelChoice, PioneerSettings, choose_model
 from perception.geometry import Pose2D, wrap_angle
 
 log = logging.getLogger(__name__)
 
-READ_TIMEOUT_S = 0.01  # how long one read may wait: bounds the I/O thread's command latency
-WRITE_TIMEOUT_S = 0.2
 CLOSE_SETTLE_S = 0.15  # after CLOSE to a robot that was still open, before syncing again
 RECONNECT_PAUSE_S = 0.2
-
-
-class PioneerSettings(BaseModel):
-    """A Pioneer base in a robot profile (``base: {driver: pioneer, port: ..., model: ...}``)."""
-
-    model_config = ConfigDict(extra="forbid")
-
-    port: str = Field(min_length=1, description="serial device or pyserial URL: /dev/ttyUSB0, "
-                      "socket://localhost:8101 (MobileSim/AMRISim), rfc2217://host:port")
-    model: Literal["auto", "p3dx", "p3at", "p3dx-sh", "p3at-sh"] = Field(
-        "auto", description="robot model for the unit conversions (position units, speed limits); "
-        "'-sh' is the newer SH firmware with 1 mm position units; 'auto' takes the subclass the "
-        "robot reports when it connects")
-    baud: Literal[9600, 19200, 38400, 57600, 115200] = Field(
-        9600, description="serial speed [bit/s]; ignored for socket:// URLs", json_schema_extra={"unit": "bit/s"})
-    reconnect: bool = Field(False, description="retry a lost link for reconnect_timeout before "
-                            "reporting the fault (the robot's own watchdog stops it meanwhile)")
-    reconnect_timeout: float = quantity(10.0, "how long to retry a lost link when reconnect is on", "s",
-                                        ge=0.5, le=300.0)
-    connect_timeout: float = quantity(5.0, "time allowed for the whole connection sequence", "s", ge=0.2, le=60.0)
-    reply_timeout: float = quantity(0.5, "wait for each reply of the connection sequence before "
-                                    "sending again", "s", ge=0.02, le=5.0)
-    sip_timeout: float = quantity(0.5, "no SIP for this long is a lost link (the robot sends one every "
-                                  "100 ms)", "s", ge=0.05, le=5.0)
-    resend_period: float = quantity(0.2, "period of re-sending the current velocity command (a command "
-                                    "at least every 0.5 s keeps the robot's watchdog quiet)", "s",
-                                    ge=0.01, le=0.45)
-    command_timeout: float = quantity(1.0, "no drive() call for this long while moving stops the base "
-                                      "(guards against a stuck control loop)", "s", ge=0.05, le=60.0)
-    max_speed: float | None = quantity(None, "forward speed limit (default: the model's)", "m/s",
-                                       ge=0.01, le=2.2)
-    max_turn_rate: float | None = quantity(None, "turn rate limit (default: the model's)", "deg/s",
-                                           ge=1.0, le=500.0)
-    sonar: bool = Field(True, description="enable the sonar rings")
-    request_config: bool = Field(True, description="ask for the config packet when connecting (limits, "
-                                 "firmware watchdog, serial number; shown by 'bearings doctor')")
+CYCLE_PAUSE_S = 0.1  # ARIA: one SIP cycle after the SYNC2 echo before OPEN; p2os waits 200 ms around CLOSE
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,25 +108,20 @@ class PioneerBase:
         self.fault: str | None = None
         self.identity: Identity | None = None
         self.config: RobotConfig | None = None
-        self.params: ModelParams | None = None
+        self.model: ModelChoice | None = None
         self.reconnects = 0
         self.deadman_stops = 0
         self.clamped_commands = 0
         self.link_down: str | None = None  # reason while a reconnection is being attempted
         self._stamp = monotonic_stamp(clock)
-        self._port_factory = port_factory or serial.serial_for_url
-        self._serial: Any = None
-        self._reader = PacketReader()
+        self._link = ArcosPort(settings.port, port_factory or serial.serial_for_url)
         self._odometry: Odometry | None = None
         self._status: BaseStatus | None = None
         self._sonar: dict[int, float] = {}
-        self._pending: list[bytes] = []
         self._sips = 0  # SIPs decoded since the base was built
-        self.model_warning: str | None = None
         self._target = (0.0, 0.0)  # mm/s, deg/s
         self._wake = threading.Event()
         self._closing = threading.Event()
-        self._write_lock = threading.RLock()  # re-entrant: stop() may run in a signal handler
         self._thread: threading.Thread | None = None
         self._last_drive = time.monotonic()
         self._last_sip = time.monotonic()
@@ -213,8 +178,33 @@ class PioneerBase:
 
     # -- accessors for doctor and the runner ---------------------------------------------------------
     def describe(self) -> str:
-        baud = "" if "://" in self.settings.port else f" at {self.settings.baud} bit/s"
+        baud = "" if self.baud is None else f" at {self.baud} bit/s"
         return f"pioneer on {self.settings.port}{baud}"
+
+    @property
+    def baud(self) -> int | None:
+        """The serial speed in use (None over a socket)."""
+        return self._link.baud
+
+    @property
+    def params(self) -> ModelParams | None:
+        """The conversion factors in use (None before the robot has said what it is)."""
+        return self.model.params if self.model is not None else None
+
+    @property
+    def model_warning(self) -> str | None:
+        """Set when ``model_override`` contradicts the subclass the robot reports."""
+        return self.model.warning if self.model is not None else None
+
+    def report_sections(self) -> dict[str, Any]:
+        """What the run report says about the base: the model and factors in use and where they came
+        from, the link's speed, what the robot said about itself."""
+        section: dict[str, Any] = {"port": self.settings.port, "baud": self.baud}
+        if self.model is not None:
+            section.update(self.model.as_report())
+        if self.identity is not None:
+            section["robot_name"] = self.identity.name
+        return {"base": section}
 
     def status(self) -> BaseStatus:
         """The newest decoded SIP (pose, velocity, battery, stall, bumpers, sonar); never blocks."""
@@ -230,7 +220,7 @@ class PioneerBase:
 
     def limits(self) -> tuple[float, float]:
         """``(max forward speed m/s, max turn rate deg/s)`` the driver clamps commands to."""
-        params = self.params or arcos.MODELS["p3at"]
+        params = self.params or arcos.MODELS["p3at"]  # the slower model until the robot has said
         max_v = self.settings.max_speed if self.settings.max_speed is not None else params.max_vel / 1000.0
         max_w = self.settings.max_turn_rate if self.settings.max_turn_rate is not None else params.max_rot_vel
         return min(max_v, params.max_vel / 1000.0), min(max_w, params.max_rot_vel)
@@ -238,7 +228,7 @@ class PioneerBase:
     @property
     def reader_stats(self) -> arcos.ReaderStats:
         """Packets parsed, bad checksums and skipped bytes on the link so far."""
-        return self._reader.stats
+        return self._link.reader.stats
 
     # -- connecting --------------------------------------------------------------------------------
     def connect(self) -> PioneerBase:
@@ -261,35 +251,38 @@ class PioneerBase:
     def _connect_once(self, deadline: float) -> None:
         self._open_port()
         self._sync(deadline)
-        self._resolve_model()
+        self._pause(CYCLE_PAUSE_S)
         self._send(arcos.encode_command(Command.OPEN))
+        self.model = choose_model(self.identity.subclass if self.identity else "", self.settings.model_override,
+                                  self.settings.port)  # after OPEN, as ARIA: a robot it has no factors for is CLOSEd
+        if self.model.warning:
+            log.warning("%s", self.model.warning)
         if self.settings.request_config:
             self.config = self._await_config(deadline) or self.config
+        if self._may_switch_baud() and self._link.switch_speed(self.settings.switch_baud):
+            log.info("Pioneer on %s: link moved to %d bit/s", self.settings.port, self.settings.switch_baud)
         self._send(arcos.encode_command(Command.SONAR, 1 if self.settings.sonar else 0))
         self._send(arcos.encode_command(Command.ENABLE, 1))
         self._send_velocity()
         self._await_first_sip(deadline)
 
     def _open_port(self) -> None:
-        port = self.settings.port
-        try:
-            self._serial = self._port_factory(port, baudrate=self.settings.baud, timeout=READ_TIMEOUT_S,
-                                              write_timeout=WRITE_TIMEOUT_S)
-        except (serial.SerialException, OSError, ValueError) as exc:
-            raise ConnectionError(f"cannot open the Pioneer port {port}: {exc}") from None
-        self._reader = PacketReader()
+        self._link.open(self.settings.baud)
 
     def _sync(self, deadline: float) -> None:
         """SYNC0, SYNC1, SYNC2 with their echoes; anything out of sequence starts again at SYNC0."""
-        step = 0
+        step, silent = 0, 0
         while step <= arcos.SYNC2:
             if time.monotonic() > deadline:
                 raise TimeoutError(f"no ARCOS reply on {self.settings.port} within "
                                    f"{self.settings.connect_timeout:g} s (robot off, wrong port or baud?)")
             self._send(arcos.encode_command(step))
             payload = self._next_packet(min(deadline, time.monotonic() + self.settings.reply_timeout))
+            silent = silent + 1 if payload is None else 0
             if payload is None:
                 step = 0
+                if silent == 2:
+                    self._link.close_at_every_speed()
             elif payload[0] in (arcos.SIP_STOPPED, arcos.SIP_MOVING):
                 self._close_stale_session()
                 step = 0
@@ -305,24 +298,13 @@ class PioneerBase:
         log.info("Pioneer on %s was still connected; closing that session first", self.settings.port)
         self._send(arcos.encode_command(Command.CLOSE))
         time.sleep(CLOSE_SETTLE_S)
-        with contextlib.suppress(serial.SerialException, OSError):
-            self._serial.reset_input_buffer()
-        self._reader.clear()
+        self._link.forget_input()
 
-    def _resolve_model(self) -> None:
-        subclass = self.identity.subclass if self.identity else ""
-        params = arcos.model_for(subclass)
-        if self.settings.model != "auto":
-            self.params = arcos.MODELS[self.settings.model]
-            if params is not None and params.name != self.params.name:
-                self.model_warning = (f"the profile says model {self.params.name} but the robot reports "
-                                      f"{subclass!r}; odometry uses {self.params.name}")
-                log.warning("%s", self.model_warning)
-            return
-        if params is None:
-            raise ConnectionError(f"the robot on {self.settings.port} reports subclass {subclass!r}, which this "
-                                  f"driver does not know; set model: {', '.join(arcos.MODELS)} in the profile")
-        self.params = params
+    def _may_switch_baud(self) -> bool:
+        """ARIA moves to a faster speed only on a serial device and when the config packet allows it."""
+        target = self.settings.switch_baud
+        return bool(target) and self._link.baud not in (None, target) and self.config is not None \
+            and self.config.allows_hostbaud
 
     def _await_config(self, deadline: float) -> RobotConfig | None:
         sent_at = None
@@ -363,16 +345,9 @@ class PioneerBase:
 
     def _next_packet(self, until: float) -> bytes | None:
         """The next valid packet before ``until`` (used while connecting, before the I/O thread)."""
-        while True:
-            if self._pending:
-                return self._pending.pop(0)
-            if time.monotonic() >= until:
-                return None
-            if self._closing.is_set() or self._serial is None:
-                raise ConnectionError("the base is being closed")
-            data = self._serial.read(self._serial.in_waiting or 1)
-            if data:
-                self._pending = self._reader.feed(data)
+        if self._closing.is_set():
+            raise ConnectionError("the base is being closed")
+        return self._link.next_packet(until)
 
     # -- the I/O thread ----------------------------------------------------------------------------
     def _run(self) -> None:
@@ -390,13 +365,13 @@ class PioneerBase:
                 return
 
     def _cycle(self, next_send: float) -> float:
-        if self._serial is None:
+        if not self._link.is_open:
             raise _LinkLost("the port is closed")
         try:
-            data = self._serial.read(self._serial.in_waiting or 1)
+            payloads = self._link.read()
         except (serial.SerialException, OSError) as exc:
             raise _LinkLost(f"link to {self.settings.port} lost: {exc}") from None
-        for payload in self._reader.feed(data) if data else ():
+        for payload in payloads:
             self._handle(payload)
         now = time.monotonic()
         if now - self._last_sip > self.settings.sip_timeout:
@@ -430,18 +405,20 @@ class PioneerBase:
                 self.config = arcos.decode_config(payload)
 
     def _update(self, sip: Sip) -> None:
-        params = self.params or arcos.MODELS["p3dx-sh"]
+        params = self.params
+        if params is None:
+            return  # not synced yet: a SIP cannot be read without the robot's units
         if self._odometry is None:
             self._odometry = Odometry(params)
         x, y, theta = self._odometry.update(sip)
         for index, raw in sip.sonar:
             self._sonar[index] = raw * params.range_conv / 1000.0
-        left, right = sip.left_vel * params.vel_conv, sip.right_vel * params.vel_conv
+        v, w = arcos.measured_velocity(sip, params)
         stamp = self._stamp()
         self._status = BaseStatus(
             pose=Pose2D(x / 1000.0, y / 1000.0, wrap_angle(theta), stamp),
-            v=(left + right) / 2000.0,
-            w=(right - left) / 2.0 * params.diff_conv,
+            v=v / 1000.0,
+            w=math.radians(w),
             battery=(sip.battery_x10 if sip.battery_x10 is not None else sip.battery) / 10.0,
             left_stall=sip.left_stall,
             right_stall=sip.right_stall,
@@ -486,10 +463,7 @@ class PioneerBase:
 
     # -- writing -----------------------------------------------------------------------------------
     def _send(self, data: bytes) -> None:
-        with self._write_lock:
-            if self._serial is None:
-                raise serial.SerialException("port closed")
-            self._serial.write(data)
+        self._link.send(data)
 
     def _send_velocity(self) -> None:
         mm_s, deg_s = self._target
@@ -504,18 +478,22 @@ class PioneerBase:
             self._send(data)
 
     def _say_goodbye(self) -> None:
+        """Stop, motors off, a pause of one SIP cycle (ARIA 100 ms, p2os 200 ms), CLOSE; the port is
+        flushed so CLOSE is on the wire before it is released."""
         with contextlib.suppress(Exception):
             self._send(arcos.encode_command(Command.STOP) + arcos.encode_vel(0) + arcos.encode_rvel(0)
-                       + arcos.encode_command(Command.ENABLE, 0) + arcos.encode_command(Command.CLOSE))
-            self._serial.flush()
+                       + arcos.encode_command(Command.ENABLE, 0))
+            self._link.flush()
+            self._pause(CYCLE_PAUSE_S)
+            self._send(arcos.encode_command(Command.CLOSE))
+            self._link.flush()
+
+    def _pause(self, seconds: float) -> None:
+        """The protocol's pauses (before OPEN, before CLOSE, around HOSTBAUD): one place to see them."""
+        time.sleep(seconds)
 
     def _release_port(self) -> None:
-        with self._write_lock:
-            port, self._serial = self._serial, None
-        if port is not None:
-            with contextlib.suppress(Exception):
-                port.close()
-        self._pending = []
+        self._link.release()
         if self._odometry is not None:
             self._odometry.restart()
 

@@ -1,7 +1,7 @@
 """FLIR/DPerception PTU-D46 pan-tilt unit over its ASCII protocol: implements ``PanTilt``.
 
-``open_ptu(PtuD46Settings(port="/dev/ttyUSB1"))`` opens the port and initialises the unit the way
-PROTOCOLS.md recommends: terse feedback (``FT``), echo off (``ED``), then anything the unit
+``open_ptu(PtuD46Settings(port="/dev/ttyUSB1"))`` opens the port and initialises the unit as
+flir_ptu_driver does (docs/protocols.md): terse feedback (``FT``), echo off (``ED``), then anything the unit
 printed (power-up banner, echoed text) is flushed, position control (``CI``), and the resolution
 (``PR`` then ``TR``), position limits (``PN PX TN TX``), speed bounds (``PL PU TL TU``), version
 (``V``) and current position are queried. Then one I/O thread owns the port: it sends the newest
@@ -12,8 +12,13 @@ every ``poll_period``. ``move()``, ``halt()`` and ``state()`` return at once.
   ``ValueError`` in ``move()`` before anything is sent; speeds are clamped to the unit's bounds.
 - A ``!`` reply to a command is kept in ``last_error`` (``errors`` counts them) and raised once
   as :class:`PtuError` from the next ``move()`` or ``state()``.
-- Unsolicited lines are tolerated: ``!P``/``!T`` (limit hit) are counted in ``limit_hits``,
-  anything that starts with neither ``*`` nor ``!`` is ignored.
+- What the unit sends is read as a stream of ``*``/``!`` messages, not lines
+  (:class:`~drivers.ptu_d46_codec.MessageReader`). Unsolicited ones are tolerated: ``!P``/``!T``
+  (limit hit) are counted in ``limit_hits``, text outside a message is ignored.
+- A unit that resets (power glitch, ``R``) homes: it hits its limits (``!T!T!P!P``), may stay
+  silent meanwhile, and ends with ``*``. Missing replies after a limit hit do not count as a lost
+  link for ``homing_timeout``; when the homing ends (``homings`` counts them) the last move is sent
+  again, since the unit is back at its home position.
 - ``max_timeouts`` replies missing in a row, or a read/write error, is a lost link: ``fault`` is
   set and ``move()``/``state()`` raise :class:`DriverFault`. ``halt()`` and ``close()`` never raise.
 """
@@ -55,6 +60,9 @@ class PtuD46Settings(BaseModel):
     poll_period: float = quantity(0.1, "period of the position read-back", "s", ge=0.02, le=2.0)
     init_settle: float = quantity(0.2, "after FT and ED, how long to let the unit's replies and power-up "
                                   "text arrive before they are flushed", "s", ge=0.0, le=5.0)
+    homing_timeout: float = quantity(30.0, "after an unsolicited limit hit (the unit homing after a reset), how "
+                                     "long missing replies are waited for before they count as a lost link",
+                                     "s", ge=1.0, le=120.0)
     pan_min_deg: float | None = quantity(None, "soft pan limit tighter than the unit's", "deg", ge=-180, le=180)
     pan_max_deg: float | None = quantity(None, "soft pan limit tighter than the unit's", "deg", ge=-180, le=180)
     tilt_min_deg: float | None = quantity(None, "soft tilt limit tighter than the unit's", "deg", ge=-90, le=90)
@@ -94,6 +102,10 @@ class _Timeout(Exception):
     pass
 
 
+class _Homing(_Timeout):
+    """No reply while the unit is homing (limit hits seen, its closing ``*`` not yet)."""
+
+
 class _Refused(Exception):
     pass
 
@@ -110,18 +122,21 @@ class PtuD46:
         self.limit_hits = 0
         self.timeouts = 0
         self.late_replies = 0
+        self.homings = 0
         self.version = ""
         self.limits: PtuLimits | None = None
         self._stamp = monotonic_stamp(clock)
         self._port_factory = port_factory or serial.serial_for_url
         self._serial: Any = None
-        self._lines = codec.LineReader()
+        self._messages = codec.MessageReader()
         self._unraised_error: str | None = None
         self._state = PanTiltState()
         self._positions = (0, 0)
         self._target: tuple[int, int] | None = None
         self._pending_move: tuple[int, int, int, int] | None = None  # pan, tilt, pan speed, tilt speed
         self._pending_halt = False
+        self._last_move: tuple[int, int, int, int] | None = None  # sent again after the unit homed
+        self._homing_since: float | None = None  # first limit hit of a reset still in progress
         self._speeds: tuple[int | None, int | None] = (None, None)
         self._missed = 0
         self._lock = threading.RLock()
@@ -208,7 +223,8 @@ class PtuD46:
             raise ConnectionError(f"the PTU-D46 on {port} refused {exc} while initialising") from None
         except _Timeout as exc:
             self._release_port()
-            raise TimeoutError(f"the PTU-D46 on {port} did not answer {exc} within "
+            homing = " (it is homing)" if isinstance(exc, _Homing) else ""
+            raise TimeoutError(f"the PTU-D46 on {port}{homing} did not answer {exc} within "
                                f"{self.settings.reply_timeout:g} s (unit off, wrong port or baud?)") from None
         except (serial.SerialException, OSError) as exc:
             self._release_port()
@@ -244,7 +260,7 @@ class PtuD46:
         while time.monotonic() < end:
             self._serial.read(self._serial.in_waiting or 1)
         self._serial.reset_input_buffer()
-        self._lines.clear()
+        self._messages.reset()
 
     # -- the I/O thread ----------------------------------------------------------------------------
     def _run(self) -> None:
@@ -264,6 +280,8 @@ class PtuD46:
             halt, self._pending_halt = self._pending_halt, False
             move = None if halt else self._pending_move
             self._pending_move = None
+            if halt:
+                self._last_move = None
         try:
             if halt:
                 self._command("H")
@@ -280,6 +298,9 @@ class PtuD46:
         except _Refused as exc:
             self._missed = 0
             self._record_error(str(exc))
+        except _Homing as exc:
+            self._missed = 0
+            log.info("PTU-D46: no reply to %s while the unit homes", exc)
         except _Timeout as exc:
             self.timeouts += 1
             self._missed += 1
@@ -289,6 +310,7 @@ class PtuD46:
         return next_poll
 
     def _send_move(self, move: tuple[int, int, int, int]) -> None:
+        self._last_move = move
         pan, tilt, pan_speed, tilt_speed = move
         if self._speeds[0] != pan_speed and self._command("PS", pan_speed):
             self._speeds = (pan_speed, self._speeds[1])
@@ -356,31 +378,55 @@ class PtuD46:
         answer: codec.Reply | None = None
         while answer is None and time.monotonic() < deadline:
             chunk = self._serial.read(self._serial.in_waiting or 1)
-            for line in self._lines.feed(chunk) if chunk else ():
-                reply = codec.parse_line(line)
+            for reply in self._messages.feed(chunk) if chunk else self._messages.idle():
                 if answer is None and (reply.kind == "error" or (reply.kind == "ok" and _fits(reply, shape))):
                     answer = reply
                 else:
                     self._note_unsolicited(reply)
-        if answer is None:
-            raise _Timeout(data.decode("ascii").strip())
-        return answer
+        what = data.decode("ascii").strip()
+        if answer is not None:
+            self._homing_since = None
+            return answer
+        if self._homing_since is not None and time.monotonic() - self._homing_since < self.settings.homing_timeout:
+            raise _Homing(what)
+        raise _Timeout(what)
 
     def _note_unsolicited(self, reply: codec.Reply) -> None:
-        """A line that answers nothing we wait for: count limit hits and late replies, ignore noise."""
+        """A message that answers nothing we wait for: count limit hits and late replies, follow a
+        reset's homing, ignore noise."""
         if reply.kind == "limit":
             self.limit_hits += 1
+            self._homing_since = self._homing_since or time.monotonic()
             log.info("PTU-D46 reports a %s limit hit", reply.axis)
+        elif reply.kind == "homed":
+            self._homed()
         elif reply.kind in ("ok", "error"):
             self.late_replies += 1
+            self._homing_since = None
+
+    def _homed(self) -> None:
+        """The unit reset and homed: it is at its home position with its default speeds; the last
+        move is sent again."""
+        self.homings += 1
+        self._homing_since = None
+        log.warning("PTU-D46 on %s reset and homed; sending the last move again", self.settings.port)
+        with self._lock:
+            self._speeds = (None, None)
+            if self._last_move is not None and self._pending_move is None and not self._pending_halt:
+                self._pending_move = self._last_move
+                self._target = self._last_move[:2]
+                self._publish(moving=True)
+        self._wake.set()
 
     def _skip_pending(self) -> None:
-        """Before a command: read what is waiting (unsolicited lines, late replies) so it cannot be
-        taken for this command's reply; a half-received line is dropped."""
+        """Before a command: read what is waiting (unsolicited messages, late replies) so it cannot be
+        taken for this command's reply; a half-received message is dropped."""
         while self._serial.in_waiting:
-            for line in self._lines.feed(self._serial.read(self._serial.in_waiting)):
-                self._note_unsolicited(codec.parse_line(line))
-        self._lines.clear()
+            for reply in self._messages.feed(self._serial.read(self._serial.in_waiting)):
+                self._note_unsolicited(reply)
+        for reply in self._messages.idle():
+            self._note_unsolicited(reply)
+        self._messages.clear()
 
     # -- helpers -----------------------------------------------------------------------------------
     def _position(self, axis: str, angle: float, limits: AxisLimits, soft_min: float | None,

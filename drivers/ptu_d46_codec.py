@@ -1,11 +1,14 @@
 """PTU-D46 ASCII protocol: pure functions, bytes in and values out (no port, no thread, no clock).
 
-Commands are ASCII tokens ended by a space (``PP1000 ``, ``PR ``); a reply is a line ended by CR LF
-that starts with ``*`` (success; a query adds its value: ``* 185.1428``) or ``!`` (failure:
-``! Illegal argument``). A bare ``!P`` / ``!T`` is the unit's unsolicited "pan/tilt limit hit";
-any other line (power-up banner, echoed input before ``ED``) is noise to be ignored. Positions are
-integers; resolution is in arc-seconds per position (``PR`` / ``TR``). Facts from
-``../shared/PROTOCOLS.md``, checked against the flir_ptu driver.
+Commands are ASCII tokens ended by a space (``PP1000 ``, ``PR ``). What the unit sends is a stream
+of messages, each starting with ``*`` (success; a query adds its value: ``* 185.1428``) or ``!``
+(failure: ``! Illegal argument``; ``!P`` / ``!T``: a pan / tilt limit was hit). Messages need not
+be on lines of their own: a unit that resets and homes writes ``!T!T!P!P*`` in one go (limit hits
+while it finds its limits, then ``*`` when it is done), so :class:`MessageReader` splits the
+stream at the markers, as ARIA's ``ArDPPTU::readPacket`` does, not at line ends. Text outside a
+message (power-up banner, echoed input before ``ED``) is noise. Positions are integers;
+resolution is in arc-seconds per position (``PR`` / ``TR``). The grammar and its sources are in
+``docs/protocols.md``.
 """
 
 from __future__ import annotations
@@ -16,7 +19,8 @@ from dataclasses import dataclass
 
 NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?")
 TOKEN = re.compile(r"([A-Za-z]+)([-+]?\d+(?:\.\d+)?)?")
-MAX_LINE = 256  # a longer run of bytes without a line end is noise and is dropped
+MAX_MESSAGE = 256  # a longer message is noise and is dropped
+LIMIT_AXES = {"!P": "pan", "!T": "tilt"}
 
 
 def encode(command: str, value: int | None = None) -> bytes:
@@ -43,37 +47,10 @@ def split_commands(data: str) -> list[tuple[str, float | None]]:
     return out
 
 
-class LineReader:
-    """Incremental line splitter: :meth:`feed` any chunks, get back complete stripped lines."""
-
-    def __init__(self) -> None:
-        self._buffer = bytearray()
-        self.dropped = 0  # bytes dropped because no line end came within MAX_LINE
-
-    def feed(self, data: bytes) -> list[str]:
-        self._buffer += data
-        lines: list[str] = []
-        while True:
-            ends = [i for i in (self._buffer.find(b"\r"), self._buffer.find(b"\n")) if i >= 0]
-            if not ends:
-                break
-            end = min(ends)
-            raw, self._buffer = bytes(self._buffer[:end]), self._buffer[end + 1 :]
-            text = raw.decode("ascii", errors="replace").strip()
-            if text:
-                lines.append(text)
-        if len(self._buffer) > MAX_LINE:
-            self.dropped += len(self._buffer)
-            self._buffer.clear()
-        return lines
-
-    def clear(self) -> None:
-        self._buffer.clear()
-
-
 @dataclass(frozen=True, slots=True)
 class Reply:
-    """One classified line: ``ok`` (``*``), ``error`` (``! message``), ``limit`` (``!P``/``!T``), ``noise``."""
+    """One message: ``ok`` (``*``), ``error`` (``! message``), ``limit`` (``!P``/``!T``), ``homed``
+    (the ``*`` that ends a reset: it follows limit hits on both axes), or ``noise``."""
 
     kind: str
     text: str
@@ -81,21 +58,91 @@ class Reply:
 
     @property
     def axis(self) -> str | None:
-        """``"pan"`` or ``"tilt"`` for a limit line."""
-        return {"!P": "pan", "!T": "tilt"}.get(self.text.upper().replace(" ", "")) if self.kind == "limit" else None
+        """``"pan"`` or ``"tilt"`` for a limit message."""
+        return LIMIT_AXES.get(self.text.upper().replace(" ", "")) if self.kind == "limit" else None
 
 
-def parse_line(line: str) -> Reply:
-    """Classify one reply line and pull out a query's number (terse ``* 12`` or verbose text)."""
-    text = line.strip()
+def parse_message(text: str) -> Reply:
+    """Classify one complete message and pull out a query's number (terse ``* 12`` or verbose text)."""
+    text = text.strip()
     if text.startswith("*"):
         match = NUMBER.search(text[1:])
         return Reply("ok", text, float(match.group()) if match else None)
-    if text.upper().replace(" ", "") in ("!P", "!T"):
+    if text.upper().replace(" ", "") in LIMIT_AXES:
         return Reply("limit", text)
     if text.startswith("!"):
         return Reply("error", text[1:].strip() or "error")
     return Reply("noise", text)
+
+
+class MessageReader:
+    """Incremental splitter of the unit's output: :meth:`feed` any chunks, get back :class:`Reply`.
+
+    A message starts at ``*`` (always, even inside another one) or at ``!`` (unless it is inside the
+    text of a ``* ...`` / ``! ...`` message), and ends at a line end or where the next one starts;
+    ``!P`` / ``!T`` end at their letter. Limit hits on both axes followed by a bare ``*`` with no
+    other message between them are a reset that finished: that ``*`` is ``homed``, not an answer.
+    Its ``*`` has no line end after it: :meth:`idle` (nothing arrived for a while) completes it.
+    """
+
+    def __init__(self) -> None:
+        self._text: str | None = None  # the message being read, from its marker; None between messages
+        self._limit_axes: set[str] = set()  # axes of the limit hits since the last other message
+        self.noise = 0  # characters outside any message (banner, echo) and over-long messages
+
+    def feed(self, data: bytes) -> list[Reply]:
+        out: list[Reply] = []
+        for char in data.decode("ascii", errors="replace"):
+            self._take(char, out)
+        return out
+
+    def idle(self) -> list[Reply]:
+        """Nothing more arrived: a bare ``*`` after limit hits (the end of a reset) is complete."""
+        out: list[Reply] = []
+        if self._text == "*" and self._limit_axes:
+            self._finish(out)
+        return out
+
+    def clear(self) -> None:
+        """Drop a half-received message (a late reply cut by a new command), keep the limit hits seen."""
+        if self._text is not None:
+            self.noise += len(self._text)
+        self._text = None
+
+    def reset(self) -> None:
+        self.clear()
+        self._limit_axes.clear()
+
+    def _take(self, char: str, out: list[Reply]) -> None:
+        text = self._text
+        if char in "\r\n":
+            if text is not None:
+                self._finish(out)
+            return
+        if char == "*" or (char == "!" and not (text is not None and text[1:2] == " ")):
+            if text is not None:
+                self._finish(out)
+            self._text = char
+            return
+        if text is None:
+            self.noise += 1
+            return
+        self._text = text + char
+        if text == "!" and char.upper() in "PT":
+            self._finish(out)  # "!P" / "!T" are complete at their letter
+        elif len(self._text) > MAX_MESSAGE:
+            self.clear()
+
+    def _finish(self, out: list[Reply]) -> None:
+        reply = parse_message(self._text or "")
+        self._text = None
+        if reply.kind == "limit":
+            self._limit_axes.add(reply.axis or "")
+        else:
+            if reply.kind == "ok" and reply.text == "*" and self._limit_axes >= {"pan", "tilt"}:
+                reply = Reply("homed", "*")
+            self._limit_axes.clear()
+        out.append(reply)
 
 
 def to_positions(angle: float, resolution: float) -> int:

@@ -49,6 +49,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
+from typing import Any, overload
 
 import numpy as np
 from scipy import ndimage
@@ -138,8 +139,13 @@ class CoverageGrid:
         """Centre of each heading bin (rad, reference frame)."""
         return (np.arange(self.heading_bins) + 0.5) * HEADING_BIN
 
-    def position(self, ix: int, iy: int) -> tuple[float, float]:
-        """Reference-frame position (m) of a cell centre."""
+    @overload
+    def position(self, ix: int, iy: int) -> tuple[float, float]: ...
+    @overload
+    def position(self, ix: np.ndarray, iy: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def position(self, ix: int | np.ndarray, iy: int | np.ndarray) -> tuple[Any, Any]:
+        """Reference-frame position (m) of a cell centre; of each cell of index arrays (``np.nonzero``)."""
         return self.origin[0] + ix * self.cell, self.origin[1] + iy * self.cell
 
     def index(self, x: float, y: float) -> tuple[int, int] | None:

@@ -1,16 +1,55 @@
-"""The ``bearings`` command line: one sub-command per module of :mod:`missions.commands`."""
+"""The ``bearings`` command line: one sub-command per command module.
+
+The built-in commands are the modules of :data:`missions.commands.COMMANDS`; the others (the
+``experiments`` package's ``sweep``, ``eval`` and ``bench``, or a plugin package's) are found by
+entry point, group :data:`missions.commands.ENTRY_POINT_GROUP`, each naming a module that exposes
+``register(subparsers)`` (as ros2cli finds its verbs). The CLI never imports them by name, so
+``missions`` does not depend on what is built on it. ``bearings --help`` lists the built-ins,
+then the entry points by name. An entry point that cannot be loaded or registered costs its own
+command only: one line on stderr names it and the others work.
+"""
 
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib
 import sys
+from importlib.metadata import EntryPoint, entry_points
 
-from missions.commands import COMMANDS
+from missions.commands import COMMANDS, ENTRY_POINT_GROUP
 
 EPILOG = """exit codes: 0 mission SUCCESS / command done, 1 mission FAILURE, 2 invalid input,
 130/143 interrupted by SIGINT/SIGTERM.
 Run 'bearings COMMAND --help' for the options of one command."""
+
+
+@functools.cache
+def command_entry_points() -> tuple[EntryPoint, ...]:
+    """The installed entry points of the commands group, by name (then module: a stable order).
+    Read once per process: the sweep's episode server forks children that all inherit it."""
+    return tuple(sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: (e.name, e.value)))
+
+
+def _add_builtin(sub: argparse._SubParsersAction) -> None:
+    for module_name in COMMANDS:
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as exc:
+            if exc.name == module_name:  # a command not written yet
+                continue
+            raise
+        module.register(sub)
+
+
+def _add_entry_point(sub: argparse._SubParsersAction, entry: EntryPoint) -> None:
+    """Register the command of one entry point; if that fails, say so in one line and go on."""
+    try:
+        entry.load().register(sub)
+    except Exception as exc:  # an entry point is someone else's code: whatever it raises, the CLI stays up
+        said = str(exc).strip().splitlines()
+        print(f"bearings: command {entry.name!r} ({entry.value}) is not available: {type(exc).__name__}"
+              + (f": {said[0]}" if said else ""), file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -21,14 +60,9 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module_name in COMMANDS:
-        try:
-            module = importlib.import_module(module_name)
-        except ModuleNotFoundError as exc:
-            if exc.name == module_name:  # a command not written yet
-                continue
-            raise
-        module.register(sub)
+    _add_builtin(sub)
+    for entry in command_entry_points():
+        _add_entry_point(sub, entry)
     return parser
 
 

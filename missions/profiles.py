@@ -3,7 +3,7 @@
 A profile names a driver for the base, optionally the pan-tilt unit and cameras::
 
     robot: lab-pioneer
-    base: {driver: pioneer, port: /dev/ttyUSB0, model: p3dx}
+    base: {driver: pioneer, port: /dev/ttyUSB0}
     ptu: {driver: ptu_d46, port: /dev/ttyUSB1}
     cameras:
       omni: {driver: opencv, device: 0, calibration: omni.yaml}

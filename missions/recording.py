@@ -6,6 +6,7 @@ viewer, so it works headless; open the file later with ``rerun F.rrd``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -16,6 +17,7 @@ from py_trees.common import Status
 
 from behaviours.telemetry import Arrows, Drawing, Draws, Event, Lines, Picture, Plot, Points, Reports
 
+FIGURE_PERIOD = 1.0  # s of the run's clock between two plots of the nodes' figures (some are costly to gather)
 STATUS_CODE = {Status.INVALID: 0, Status.RUNNING: 1, Status.SUCCESS: 2, Status.FAILURE: 3}
 
 
@@ -33,6 +35,7 @@ class Recorder:
         rr.save(str(self.path))
         self._last_status: dict[str, Status] = {}
         self._last_figure: dict[str, Any] = {}
+        self._figures_at = -math.inf
         rr.log("tree/status_legend", rr.TextDocument("0 invalid, 1 running, 2 success, 3 failure"), static=True)
 
     def log_tick(self, *, time_s: float, tick: int, root: py_trees.behaviour.Behaviour, odometry: Any,
@@ -56,12 +59,15 @@ class Recorder:
                 rr.log("tree/events", rr.TextLog(message))
         for observer in observers:
             observer.log_rerun(rr)
+        figures = time_s - self._figures_at >= FIGURE_PERIOD
+        if figures:
+            self._figures_at = time_s
         for node in nodes:
-            self.log_node(node)
+            self.log_node(node, figures=figures)
 
-    def log_node(self, node: Any) -> None:
-        """A node's figures (numbers, when they change) and drawings."""
-        if isinstance(node, Reports):
+    def log_node(self, node: Any, *, figures: bool = True) -> None:
+        """A node's drawings, and with ``figures`` its figures (the numbers that changed since last plotted)."""
+        if figures and isinstance(node, Reports):
             for figure in node.figures():
                 value = figure.value
                 if isinstance(value, (int, float)) and not isinstance(value, bool):
@@ -72,8 +78,6 @@ class Recorder:
         if isinstance(node, Draws):
             for drawing in node.drawings():
                 self.draw(drawing)
-        elif callable(log := getattr(node, "log_rerun", None)):  # issue 20: going
-            log(self.rr)
 
     def draw(self, drawing: Drawing) -> None:
         """One drawing as the rerun archetype that shows it."""

@@ -25,9 +25,12 @@ In every case the base and the pan-tilt unit are commanded to stop before any dr
 and the last command recorded (report and recording) is a zero velocity.
 
 Capabilities add to the report and the recording without touching the runner: any node of the
-tree may define ``report_sections() -> dict`` (merged into the report by section name: the
-``ltmap``, ``roadmap`` and ``exploration`` sections of DESIGN.md) and ``log_rerun(rec)`` (called
-after every recorded tick). Behaviours still never see ground truth: the simulator adds its
+tree may report ``figures()`` (named values, gathered into the report's sections: ``ltmap``,
+``roadmap``, ``exploration``; numbers are plotted in the recording too) and ``drawings()``
+(geometry and events for the recording), as :mod:`behaviours.telemetry` declares. A driver of
+the robot may add report sections through ``report_sections() -> dict``
+(``report_sections() -> dict``: the Pioneer base says which model and conversion factors it
+used, and where they came from). Behaviours still never see ground truth: the simulator adds its
 ``ground_truth`` section as an observer, and evaluations combine the two.
 """
 
@@ -48,7 +51,7 @@ from py_trees.common import Status
 
 from behaviours.clock import TickClock
 from behaviours.keys import COMMAND_KEYS, input_key
-from behaviours.telemetry import Draws, Reports, Sections, section
+from behaviours.telemetry import Draws, Reports, Sections
 from drivers.interfaces import STOP, KeyboardOpener, PanTiltCommand, Robot, VelocityCommand
 from drivers.keyboard import TerminalKeys
 from maps.store import write_json
@@ -179,8 +182,7 @@ class Runner:
             py_trees.blackboard.Blackboard.set(input_key(name), value)
         # hand every node the clock and the drivers (the keyboard as an opener: a terminal is taken only if used)
         self.tree.setup(clock=self.clock, robot=self.robot, keyboard=self.keyboard)
-        self._drawers = [node for node in self.root.iterate() if isinstance(node, Reports | Draws)
-                         or callable(getattr(node, "log_rerun", None))]
+        self._drawers = [node for node in self.root.iterate() if isinstance(node, Reports | Draws)]
 
     def _loop(self) -> tuple[str, str]:
         last_progress = 0.0
@@ -274,9 +276,6 @@ class Runner:
             try:
                 if isinstance(node, Reports):
                     gathered.add(node.figures())
-                elif callable(method := getattr(node, "report_sections", None)):  # issue 20: going
-                    for name, values in method().items():
-                        gathered.add(section(name, values))
             except Exception as exc:  # noqa: BLE001 - the report must be written whatever a node does
                 gathered.sections.setdefault("report_errors", {})[node.name] = describe_exception(exc)
         return gathered.sections
@@ -319,6 +318,10 @@ class Runner:
             report.update(observer.report_sections(mission.evaluation))
         for name, values in self._node_sections().items():
             report.setdefault(name, {}).update(values)
+        for device in (self.robot.base, self.robot.ptu):
+            sections = getattr(device, "report_sections", None)
+            if callable(sections):
+                report.update(sections())
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}

@@ -1,4 +1,4 @@
-"""Depth from a rectified parallel stereo pair with a known baseline (room estimation).
+"""Depth from a rectified parallel stereo pair with a known baseline (room estimation, the exploration map).
 
 Roadmap paper: at each corner of a dodecagon the robot takes a stereo pair of parallel images;
 matches along horizontal epipolar lines give depth ``Z = f * B / d``, hence the free floor space
@@ -10,7 +10,8 @@ and the distance to the scene in every direction. Two ways are offered:
   look-alikes on the same epipolar line) is rejected as ambiguous instead of giving wrong depth;
   the mutual check removes many-to-one matches.
 - :func:`dense_depth`: OpenCV's semi-global matcher (``cv2.StereoSGBM``) with a uniqueness
-  margin (the same idea for every pixel) and left-right consistency.
+  margin (the same idea for every pixel) and left-right consistency; :func:`pyramid_points` runs
+  it on halved images and drops the smear beside depth jumps (exploration's map, every frame).
 
 Both return depths along the optical axis and 3-D points in the rig's body frame (the LEFT
 camera's: x forward, y left, z up).
@@ -23,7 +24,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from perception.camera import StereoRig
+from perception.camera import PinholeCamera, StereoRig
 from perception.features import detect
 from perception.matching import DEFAULT_RATIO
 
@@ -149,11 +150,69 @@ def dense_depth(
     return depth
 
 
-def dense_points(depth: np.ndarray, rig: StereoRig, *, step: int = 4) -> np.ndarray:
-    """Body-frame points (M x 3) of a depth map, sampled every ``step`` pixels, NaNs dropped."""
+def dense_samples(depth: np.ndarray, rig: StereoRig, *, step: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """Body-frame points (M x 3) of a depth map sampled every ``step`` pixels, NaNs dropped, and their
+    left pixels (M x 2: u, v), for those who need to know which points were image neighbours."""
     vs, us = np.mgrid[0 : depth.shape[0] : step, 0 : depth.shape[1] : step]
     z = depth[vs, us].ravel()
     ok = np.isfinite(z)
     uv = np.column_stack((us.ravel()[ok], vs.ravel()[ok])).astype(np.float64)
     bearings = rig.left.pixel_to_bearing(uv)
-    return bearings * (z[ok] / bearings[:, 0])[:, None]
+    return bearings * (z[ok] / bearings[:, 0])[:, None], uv
+
+
+def dense_points(depth: np.ndarray, rig: StereoRig, *, step: int = 4) -> np.ndarray:
+    """Body-frame points (M x 3) of a depth map, sampled every ``step`` pixels, NaNs dropped."""
+    return dense_samples(depth, rig, step=step)[0]
+
+
+BELOW_FLOOR = 0.2  # m: stereo points this far below a flat floor are wrong matches, to be dropped
+
+
+def drop_jumps(depth: np.ndarray, max_jump: float, radius: int = 3) -> np.ndarray:
+    """The depth map without the pixels within ``radius`` of a depth jump larger than ``max_jump``
+    (relative): a semi-global matcher smears depth across occluding edges (a door jamb in front of
+    the room behind), streaks that would otherwise become obstacles on the floor between the two."""
+    if max_jump <= 0.0:
+        return depth
+    kernel = np.ones((2 * radius + 1, 2 * radius + 1), np.uint8)
+    ok = np.isfinite(depth)
+    high = cv2.dilate(np.where(ok, depth, 0.0).astype(np.float32), kernel)
+    low = cv2.erode(np.where(ok, depth, np.finfo(np.float32).max).astype(np.float32), kernel)
+    keep = ok & (high - low <= max_jump * low)
+    return np.where(keep, depth, np.nan).astype(np.float32)
+
+
+def halved(rig: StereoRig) -> StereoRig:
+    """The rig of images halved by ``cv2.pyrDown`` (pixel centres: ``(u + 0.5) / 2 - 0.5``)."""
+    def half(c: PinholeCamera) -> PinholeCamera:
+        return PinholeCamera((c.width + 1) // 2, (c.height + 1) // 2, c.fx / 2.0, c.fy / 2.0,
+                             (c.cx + 0.5) / 2.0 - 0.5, (c.cy + 0.5) / 2.0 - 0.5, c.dist)
+
+    return StereoRig(half(rig.left), half(rig.right), rig.baseline)
+
+
+def pyramid_points(
+    left: np.ndarray,
+    right: np.ndarray,
+    rig: StereoRig,
+    *,
+    levels: int,
+    num_disparities: int,
+    max_jump: float,
+    step: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Dense stereo of a pair matched on images halved ``levels`` times (each level: 4x fewer pixels
+    to match, depth within a few cm at 3 m for one): body-frame points (M x 3) and their pixels in
+    the full left image (M x 2), sampled every ``step`` full-image pixels.
+
+    ``num_disparities`` is the search range of the full images (scaled down with them);
+    ``max_jump`` drops the pixels beside depth jumps (:func:`drop_jumps`, 0: keep all)."""
+    small = rig
+    for _ in range(levels):
+        left, right, small = cv2.pyrDown(left), cv2.pyrDown(right), halved(small)
+    scale = 2**levels
+    depth = dense_depth(left, right, small, num_disparities=-(-num_disparities // scale))
+    depth = drop_jumps(depth, max_jump)
+    points, uv = dense_samples(depth, small, step=max(1, step // scale))
+    return points, (uv + 0.5) * scale - 0.5  # full-image pixels: image neighbours as in the full image

@@ -18,6 +18,6 @@ module                 node types
 ``values`` holds the values these nodes hand each other through their ports, ``vision`` the
 image side (upright SIFT, matching, planar homing of one image against a target),
 ``routine`` the base class of the long-running ones (a coroutine advanced once per tick that
-drives through the standard motion nodes), ``display`` the report section and the rerun views.
+drives through the standard motion nodes), ``display`` the report figures and the drawings.
 docs/roadmap.md is the overview.
 """

@@ -23,6 +23,7 @@ Distances are not calibrated (1 % in the simulator: 6 cm over 6 m, along the tri
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from typing import Any
 
 from py_trees.common import Status
@@ -33,6 +34,7 @@ from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.vision import compare, describe
+from behaviours.telemetry import Figure
 from perception.geometry import Pose2D
 
 MAX_ERROR = 0.1  # a scale further than 10 % from 1 is not odometry miscounting: refuse it
@@ -47,10 +49,8 @@ class CalibrateTurns(RoutineBehaviour):
     the two images do not match or the scale is implausible (more than 10 % from 1).
     """
 
-    PORTS = (
-        *ROUTINE_PORTS,
-        OutputPort("turn_scale", float, "/robot/turn_scale", doc="true turn / turn counted by the odometry"),
-    )
+    TURN_SCALE = OutputPort("turn_scale", float, "/robot/turn_scale", doc="true turn / turn counted by the odometry")
+    PORTS = (*ROUTINE_PORTS, TURN_SCALE)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -77,12 +77,13 @@ class CalibrateTurns(RoutineBehaviour):
         if abs(scale - 1.0) > MAX_ERROR:
             raise Failed(f"implausible turn scale {scale:.3f}")
         self.scale = scale
-        self.set_output("turn_scale", scale)
+        self.set_output(self.TURN_SCALE, scale)
         self.feedback_message = f"turn scale {scale:.4f}: the odometry counts {100 * (1 / scale - 1):+.2f} % of a turn"
         yield
 
-    def report_sections(self) -> dict[str, Any]:
-        return {"roadmap": {"turn_scale": round(self.scale, 5)}} if self.scale is not None else {}
+    def figures(self) -> Iterator[Figure]:
+        if self.scale is not None:
+            yield Figure("roadmap", "turn_scale", round(self.scale, 5))
 
 
 @register
@@ -92,11 +93,9 @@ class CorrectOdometry(BearingsBehaviour):
     Belongs under the mission's ``sense:``: it must see every odometry reading.
     """
 
-    PORTS = (
-        ODOMETRY,
-        InputPort("turn_scale", float, Ref("/robot/turn_scale"), doc="true turn / counted turn (unset: 1)"),
-        OutputPort("calibrated", Pose2D, "/robot/calibrated_odometry", doc="odometry with calibrated turns"),
-    )
+    TURN_SCALE = InputPort("turn_scale", float, Ref("/robot/turn_scale"), doc="true turn / counted turn (unset: 1)")
+    CALIBRATED = OutputPort("calibrated", Pose2D, "/robot/calibrated_odometry", doc="odometry with calibrated turns")
+    PORTS = (ODOMETRY, TURN_SCALE, CALIBRATED)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -104,16 +103,16 @@ class CorrectOdometry(BearingsBehaviour):
         self.pose = Pose2D()
 
     def update(self) -> Status:
-        raw: Pose2D | None = self.get_input("odometry", None)
+        raw = self.get_input(ODOMETRY, None)
         if raw is None:
             return Status.SUCCESS
         if self.raw is not None:
             step = raw.relative_to(self.raw)  # this tick's motion in the robot frame
-            scale = float(self.get_input("turn_scale", 1.0) or 1.0)
+            scale = self.get_input(self.TURN_SCALE, 1.0) or 1.0
             self.pose = self.pose.compose(Pose2D(step.x, step.y, scale * step.theta))
         else:
             self.pose = Pose2D(raw.x, raw.y, raw.theta)
         self.raw = raw
         self.pose = Pose2D(self.pose.x, self.pose.y, self.pose.theta, raw.stamp)
-        self.set_output("calibrated", self.pose)
+        self.set_output(self.CALIBRATED, self.pose)
         return Status.SUCCESS

@@ -25,6 +25,7 @@ Choices where the paper is vague:
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -34,11 +35,13 @@ from behaviours.base import BearingsBehaviour
 from behaviours.motion import ODOMETRY
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
-from behaviours.roadmap.display import RoadmapDisplay
+from behaviours.roadmap.display import Drawn, coverage_drawings, roadmap_figures
+from behaviours.roadmap.room import ROOM_IN
 from behaviours.roadmap.routine import ROBOT_RADIUS
 from behaviours.roadmap.values import ScanRecord
-from maps.coverage import FRAGMENT_COST, CoverageGrid, choose_next, coverage_grid, reachable_positions
-from maps.room import RoomEstimate
+from behaviours.telemetry import Drawing, Figure
+from maps.coverage import FRAGMENT_COST as DEFAULT_FRAGMENT_COST
+from maps.coverage import CoverageGrid, choose_next, coverage_grid, reachable_positions
 from perception.geometry import Pose2D
 
 UNREACHABLE_RADIUS = 0.3  # m around a goal the robot did not reach: not a candidate again
@@ -52,18 +55,14 @@ class CoverageScoring(BearingsBehaviour):
     reference frame) and the coverage grid. FAILURE when nothing worth a visit is left.
     """
 
-    PORTS = (
-        InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate"),
-        InputPort("scan", ScanRecord, Ref("/map/scan"), doc="the images of the last scan (none yet: nothing)"),
-        ROBOT_RADIUS,
-        InputPort("min_new", int, 100, minimum=1, literal_only=True,
-                  doc="fewest newly covered configurations that make a position worth a visit"),
-        InputPort("fragment_cost", float, FRAGMENT_COST, minimum=0.0, literal_only=True,
-                  doc="configurations one more uncovered fragment is worth"),
-        ODOMETRY,
-        OutputPort("coverage", CoverageGrid, "/map/coverage", doc="the coverage grid"),
-        OutputPort("goal", Pose2D, "/map/coverage_goal", doc="the next search position (reference frame)"),
-    )
+    SCAN = InputPort("scan", ScanRecord, Ref("/map/scan"), doc="the images of the last scan (none yet: nothing)")
+    MIN_NEW = InputPort("min_new", int, 100, minimum=1, literal_only=True,
+                        doc="fewest newly covered configurations that make a position worth a visit")
+    FRAGMENT_COST = InputPort("fragment_cost", float, DEFAULT_FRAGMENT_COST, minimum=0.0, literal_only=True,
+                              doc="configurations one more uncovered fragment is worth")
+    COVERAGE = OutputPort("coverage", CoverageGrid, "/map/coverage", doc="the coverage grid")
+    GOAL = OutputPort("goal", Pose2D, "/map/coverage_goal", doc="the next search position (reference frame)")
+    PORTS = (ROOM_IN, SCAN, ROBOT_RADIUS, MIN_NEW, FRAGMENT_COST, ODOMETRY, COVERAGE, GOAL)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -72,17 +71,17 @@ class CoverageScoring(BearingsBehaviour):
         self.pending: Pose2D | None = None  # the last goal given, until a scan from it arrives
         self.unreachable: list[Pose2D] = []
         self.choices = 0
-        self.display = RoadmapDisplay()
+        self.drawn = Drawn()
 
     def update(self) -> Status:
-        room: RoomEstimate | None = self.get_input("room", None)
-        odometry: Pose2D | None = self.get_input("odometry", None)
+        room = self.get_input(ROOM_IN, None)
+        odometry = self.get_input(ODOMETRY, None)
         if room is None or odometry is None:
             self.feedback_message = "no room estimate" if room is None else "waiting for odometry"
             return Status.FAILURE if room is None else Status.RUNNING
-        radius = float(self.get_input("robot_radius"))
+        radius = self.get_input(ROBOT_RADIUS)
         grid = self.grid or coverage_grid(room, room.free, robot_radius=radius)
-        scan: ScanRecord | None = self.get_input("scan", None)
+        scan = self.get_input(self.SCAN, None)
         if scan is not None and scan.seq not in self.applied:
             self.applied.add(scan.seq)
             grid = grid.cover(scan.x, scan.y, scan.headings)  # the headings actually imaged
@@ -90,19 +89,18 @@ class CoverageScoring(BearingsBehaviour):
         if self.pending is not None:  # asked for again with no scan since: the robot did not get there
             self.unreachable.append(self.pending)
         self.grid = grid
-        self.set_output("coverage", grid)
+        self.set_output(self.COVERAGE, grid)
         here = room.to_reference(odometry)
         candidates = reachable_positions(grid, room.free, radius, here.x, here.y)
         candidates = self._without_unreachable(grid, candidates if candidates.any() else grid.valid)
         choice = choose_next(grid, candidates=candidates,
-                             min_new=int(self.get_input("min_new")),
-                             fragment_cost=float(self.get_input("fragment_cost")))
+                             min_new=self.get_input(self.MIN_NEW), fragment_cost=self.get_input(self.FRAGMENT_COST))
         if choice is None:
             self.feedback_message = f"nothing left to cover ({100 * grid.fraction_covered:.0f} % covered)"
             return Status.FAILURE
         self.choices += 1
         self.pending = Pose2D(choice.x, choice.y, math.atan2(choice.y - here.y, choice.x - here.x))
-        self.set_output("goal", self.pending)
+        self.set_output(self.GOAL, self.pending)
         self.feedback_message = (f"position {self.choices} at ({choice.x:.1f}, {choice.y:.1f}): {choice.new} new, "
                                  f"{100 * grid.fraction_covered:.0f} % covered")
         return Status.SUCCESS
@@ -111,19 +109,18 @@ class CoverageScoring(BearingsBehaviour):
         """The candidates farther than ``UNREACHABLE_RADIUS`` from every goal the robot did not reach."""
         if not self.unreachable:
             return candidates
-        ix, iy = np.indices(grid.valid.shape)
-        x, y = grid.origin[0] + ix * grid.cell, grid.origin[1] + iy * grid.cell
+        x, y = grid.position(*np.indices(grid.valid.shape))
         keep = candidates.copy()
         for goal in self.unreachable:
             keep &= np.hypot(x - goal.x, y - goal.y) > UNREACHABLE_RADIUS
         return keep
 
-    def report_sections(self) -> dict[str, Any]:
-        if self.grid is None:
-            return {}
-        return {"roadmap": {"search": {"positions_chosen": self.choices, "scans": len(self.applied),
-                                       "unreachable": len(self.unreachable),
-                                       "covered_fraction": round(self.grid.fraction_covered, 4)}}}
+    def figures(self) -> Iterator[Figure]:
+        if self.grid is not None:
+            yield from roadmap_figures({"positions_chosen": self.choices, "scans": len(self.applied),
+                                        "unreachable": len(self.unreachable),
+                                        "covered_fraction": round(self.grid.fraction_covered, 4)}, "search")
 
-    def log_rerun(self, rec: Any) -> None:
-        self.display.log_coverage(rec, self.grid)
+    def drawings(self) -> Iterator[Drawing]:
+        if self.grid is not None and self.drawn.changed("coverage", self.grid):
+            yield from coverage_drawings(self.grid)

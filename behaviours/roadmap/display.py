@@ -1,32 +1,47 @@
-"""The ``roadmap`` report section and the rerun views of the roadmap nodes.
+"""What the roadmap nodes show: the ``roadmap`` report section and their drawings for the recording.
 
-Report (``report_sections()`` of the nodes, merged by the runner under ``roadmap``):
-``turn_scale`` (CalibrateTurns), ``room`` (RoomEstimationDodecagon), ``targets`` and
-``edges``/``connected`` (from the roadmap on the blackboard: RecordTarget, BuildGraph),
-``search`` (CoverageScoring), ``reference_drift_m (NODE)`` (ReturnToReference), ``navigation``
-(NavigateToTarget). Angles in degrees, lengths in metres, poses in the reference frame.
+Report (the nodes' ``figures()``, section ``roadmap``): ``turn_scale`` (CalibrateTurns), ``room``
+(RoomEstimationDodecagon), ``targets`` and ``edges``/``connected``/``components`` (from the
+roadmap on the blackboard: RecordTarget, BuildGraph), ``search`` (CoverageScoring),
+``reference_drift_m (NODE)`` (ReturnToReference), ``navigation`` (NavigateToTarget). Angles in
+degrees, lengths in metres, poses in the reference frame.
 
-rerun (``log_rerun(rec)``, after every recorded tick; logged again only when the value
-changed), all in the reference frame under ``roadmap/``: ``room`` (free floor polygon, the
-obstacle points, the dodecagon corners), ``coverage`` (each valid position coloured by the
-fraction of its headings covered), ``targets`` (position, heading, name), ``graph`` (edges),
-``plan`` (the last planned path), ``robot`` (the odometry pose seen through the room estimate).
+Drawings (the nodes' ``drawings()``, all in the reference frame under ``roadmap/``): ``room``
+(free floor polygon, the obstacle points, the dodecagon corners, the reference), ``coverage``
+(each valid position coloured by the fraction of its headings covered), ``targets`` (position,
+heading; their names on ``targets/labels``), ``graph`` (edges), ``plan`` (the last planned path),
+``robot`` (the odometry pose seen through the room estimate). The functions here draw a value;
+a node draws it again only when it changed (:class:`Drawn`).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
 
+from behaviours.telemetry import Arrows, Colour, Drawing, Figure, Lines, Points
 from maps.coverage import CoverageGrid
 from maps.planning import PlanResult
 from maps.roadmap import Roadmap
 from maps.room import RoomEstimate
 from perception.geometry import Pose2D
 
+SECTION = "roadmap"
+FREE_COLOUR: Colour = (40, 160, 40)
+OBSTACLE_COLOUR: Colour = (120, 120, 120)
+CORNER_COLOUR: Colour = (60, 60, 200)
+REFERENCE_COLOUR: Colour = (200, 60, 200)
+TARGET_COLOUR: Colour = (230, 140, 0)
+GRAPH_COLOUR: Colour = (30, 90, 220)
+PLAN_COLOUR: Colour = (250, 60, 60)
+ROBOT_COLOUR: Colour = (0, 0, 0)
+HEADING_LENGTH = 0.3  # m: the arrow of a target's or the robot's heading
 
+
+# -- report ------------------------------------------------------------------------------------
 def pose_dict(pose: Pose2D) -> dict[str, float]:
     return {"x": round(pose.x, 4), "y": round(pose.y, 4), "theta_deg": round(math.degrees(pose.theta), 3)}
 
@@ -57,61 +72,84 @@ def room_section(room: RoomEstimate, points: list[int], features: list[int], sta
     }
 
 
-class RoadmapDisplay:
-    """Logs roadmap values to rerun, each only when it changed (by identity)."""
+def roadmap_figures(values: dict[str, Any], within: str = "") -> list[Figure]:
+    """The ``roadmap`` figures of a mapping of names to values, nested in ``within`` when given
+    (``roadmap_figures(room_section(...), "room")``: ``room.free_area_m2``, ...)."""
+    prefix = f"{within}." if within else ""
+    return [Figure(SECTION, prefix + name, value) for name, value in values.items()]
+
+
+# -- drawings ----------------------------------------------------------------------------------
+class Drawn:
+    """What a node has drawn (by identity): a value is drawn again only when it is another object."""
 
     def __init__(self) -> None:
-        self._last: dict[str, int] = {}
+        self._last: dict[str, object] = {}
 
-    def _changed(self, what: str, value: Any) -> bool:
-        if value is None or self._last.get(what) == id(value):
+    def changed(self, what: str, value: object) -> bool:
+        """True (and remembered) when ``value`` is not None and not what was drawn as ``what`` last."""
+        if value is None or self._last.get(what) is value:
             return False
-        self._last[what] = id(value)
+        self._last[what] = value
         return True
 
-    def log_room(self, rec: Any, room: RoomEstimate | None) -> None:
-        if room is None or not self._changed("room", room.polygon):  # re-anchoring keeps the map: not again
-            return
-        loop = np.vstack([room.polygon, room.polygon[:1]])
-        rec.log("roadmap/room/free", rec.LineStrips2D([loop], colors=[[40, 160, 40]], radii=0.02))
-        if len(room.obstacle_points):
-            rec.log("roadmap/room/obstacles", rec.Points2D(room.obstacle_points, radii=0.015, colors=[[120, 120, 120]]))
-        if room.corners:
-            rec.log("roadmap/room/corners", rec.Points2D([[c.x, c.y] for c in room.corners], radii=0.03))
-        rec.log("roadmap/room/reference", rec.Arrows2D(origins=[[0.0, 0.0]], vectors=[[0.4, 0.0]],
-                                                     labels=["reference"], colors=[[200, 60, 200]]))
 
-    def log_coverage(self, rec: Any, coverage: CoverageGrid | None) -> None:
-        if coverage is None or not self._changed("coverage", coverage):
-            return
-        ix, iy = np.nonzero(coverage.valid)
-        fraction = coverage.covered[ix, iy].mean(axis=1)
-        xy = np.column_stack((coverage.origin[0] + ix * coverage.cell, coverage.origin[1] + iy * coverage.cell))
-        colours = np.column_stack((255 * (1 - fraction), 80 + 175 * fraction, 60 + 0 * fraction)).astype(np.uint8)
-        rec.log("roadmap/coverage", rec.Points2D(xy, radii=coverage.cell * 0.45, colors=colours))
+def labelled_arrows(entity: str, origins: np.ndarray, vectors: np.ndarray, colour: Colour,
+                    labels: Iterable[str]) -> list[Drawing]:
+    """Arrows, and their labels on points at their origins (``ENTITY/labels``)."""
+    return [Arrows(entity, vectors, colour, origins),
+            Points(f"{entity}/labels", origins, colour, radius=0.02, labels=tuple(labels))]
 
-    def log_roadmap(self, rec: Any, roadmap: Roadmap | None) -> None:
-        if roadmap is None or not self._changed("roadmap", roadmap):
-            return
-        if roadmap.targets:
-            xy = [[t.pose.x, t.pose.y] for t in roadmap.targets]
-            heading = [[0.3 * math.cos(t.pose.theta), 0.3 * math.sin(t.pose.theta)] for t in roadmap.targets]
-            rec.log("roadmap/targets", rec.Arrows2D(origins=xy, vectors=heading, labels=list(roadmap.names),
-                                                    colors=[[230, 140, 0]]))
-        strips = [[[roadmap.target(e.source).pose.x, roadmap.target(e.source).pose.y],
-                   [roadmap.target(e.target).pose.x, roadmap.target(e.target).pose.y]] for e in roadmap.edges]
-        rec.log("roadmap/graph", rec.LineStrips2D(strips, colors=[[30, 90, 220]], radii=0.015))
 
-    def log_plan(self, rec: Any, plan: PlanResult | None) -> None:
-        if plan is None or not plan.ok or not self._changed("plan", plan):
-            return
-        rec.log("roadmap/plan", rec.LineStrips2D([[[w.x, w.y] for w in plan.waypoints]], colors=[[250, 60, 60]],
-                                                 radii=0.01))
+def room_drawings(room: RoomEstimate) -> list[Drawing]:
+    """The free floor polygon (closed), the obstacle points, the dodecagon corners and the reference."""
+    loop = np.vstack([room.polygon, room.polygon[:1]])
+    drawings: list[Drawing] = [Lines("roadmap/room/free", [loop], FREE_COLOUR, radius=0.02)]
+    if len(room.obstacle_points):
+        drawings.append(Points("roadmap/room/obstacles", room.obstacle_points, OBSTACLE_COLOUR, radius=0.015))
+    if room.corners:
+        drawings.append(Points("roadmap/room/corners", np.array([[c.x, c.y] for c in room.corners]), CORNER_COLOUR,
+                               radius=0.03))
+    drawings += labelled_arrows("roadmap/room/reference", np.array([[0.0, 0.0]]), np.array([[0.4, 0.0]]),
+                                REFERENCE_COLOUR, ["reference"])
+    return drawings
 
-    def log_robot(self, rec: Any, room: RoomEstimate | None, odometry: Pose2D | None) -> None:
-        if room is None or odometry is None:
-            return
-        pose = room.to_reference(odometry)
-        rec.log("roadmap/robot", rec.Arrows2D(origins=[[pose.x, pose.y]], vectors=[[0.3 * math.cos(pose.theta),
-                                                                                     0.3 * math.sin(pose.theta)]],
-                                              colors=[[0, 0, 0]]))
+
+def coverage_drawings(coverage: CoverageGrid) -> list[Drawing]:
+    """Each valid position, red (nothing covered) to green (every heading covered)."""
+    ix, iy = np.nonzero(coverage.valid)
+    fraction = coverage.covered[ix, iy].mean(axis=1)
+    xy = np.column_stack(coverage.position(ix, iy))
+    colours = np.column_stack((255 * (1 - fraction), 80 + 175 * fraction, 60 + 0 * fraction)).astype(np.uint8)
+    rgb = [(int(r), int(g), int(b)) for r, g, b in colours]
+    return [Points("roadmap/coverage", xy, rgb, radius=coverage.cell * 0.45)]
+
+
+def roadmap_drawings(roadmap: Roadmap) -> list[Drawing]:
+    """The targets (position, heading, name) and the edges of the graph."""
+    drawings: list[Drawing] = []
+    if roadmap.targets:
+        xy = np.array([[t.pose.x, t.pose.y] for t in roadmap.targets])
+        heading = np.array([heading_vector(t.pose) for t in roadmap.targets])
+        drawings += labelled_arrows("roadmap/targets", xy, heading, TARGET_COLOUR, roadmap.names)
+    ends = [(roadmap.target(e.source).pose, roadmap.target(e.target).pose) for e in roadmap.edges]
+    strips = [np.array([[a.x, a.y], [b.x, b.y]]) for a, b in ends]
+    drawings.append(Lines("roadmap/graph", strips, GRAPH_COLOUR, radius=0.015))
+    return drawings
+
+
+def plan_drawings(plan: PlanResult) -> list[Drawing]:
+    """The path a plan found (nothing for a failed plan)."""
+    if not plan.ok:
+        return []
+    return [Lines("roadmap/plan", [np.array([[w.x, w.y] for w in plan.waypoints])], PLAN_COLOUR, radius=0.01)]
+
+
+def robot_drawings(room: RoomEstimate, odometry: Pose2D) -> list[Drawing]:
+    """The robot's odometry pose in the reference frame, through the room estimate."""
+    pose = room.to_reference(odometry)
+    return [Arrows("roadmap/robot", np.array([heading_vector(pose)]), ROBOT_COLOUR, np.array([[pose.x, pose.y]]))]
+
+
+def heading_vector(pose: Pose2D) -> list[float]:
+    return [HEADING_LENGTH * math.cos(pose.theta), HEADING_LENGTH * math.sin(pose.theta)]

@@ -57,6 +57,7 @@ Choices where the paper is vague:
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from itertools import combinations
 from typing import Any
@@ -65,13 +66,15 @@ import numpy as np
 
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
-from behaviours.roadmap.display import RoadmapDisplay, roadmap_section
+from behaviours.roadmap.display import Drawn, roadmap_drawings, roadmap_figures, roadmap_section
 from behaviours.roadmap.homing import REQUIRED_ROOM, HomingSettings, home
-from behaviours.roadmap.paths import reanchored, travel
-from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
-from behaviours.roadmap.targets import relative_images
-from behaviours.roadmap.travel import PLAN_PORTS
+from behaviours.roadmap.paths import PLAN_PORTS, reanchored, travel
+from behaviours.roadmap.room import ROOM_IN
+from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.targets import TARGETS_IN, relative_images
+from behaviours.roadmap.travel import REFERENCE_IN, return_to_reference
 from behaviours.roadmap.values import TargetImages, TargetView
+from behaviours.telemetry import Drawing, Figure
 from maps.planning import segment_is_free
 from maps.pose_graph import refine_targets
 from maps.roadmap import EdgeMotion, InconsistentEstimates, Roadmap
@@ -126,21 +129,16 @@ class BuildGraph(RoutineBehaviour):
     edges (``roadmap_out``) and saves it to ``file``; FAILURE when the graph is not connected.
     """
 
-    PORTS = (
-        InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the targets found (reference frame)"),
-        InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the target images"),
-        InputPort("reference", TargetView, Ref("/map/reference_image"), doc="the image taken at the reference"),
-        InputPort("file", str, "", doc="where to save the roadmap ('' : do not save)"),
-        *REQUIRED_ROOM,
-        *PLAN_PORTS,
-        *ROUTINE_PORTS,
-        OutputPort("roadmap_out", Roadmap, "/map/roadmap", doc="the roadmap with its edges"),
-        OutputPort("room_out", RoomEstimate, "/map/room", doc="the room, anchored where the robot last homed"),
-    )
+    ROADMAP = InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the targets found (reference frame)")
+    FILE = InputPort("file", str, "", doc="where to save the roadmap ('' : do not save)")
+    ROADMAP_OUT = OutputPort("roadmap_out", Roadmap, "/map/roadmap", doc="the roadmap with its edges")
+    ROOM_OUT = OutputPort("room_out", RoomEstimate, "/map/room", doc="the room, anchored where the robot last homed")
+    PORTS = (ROADMAP, TARGETS_IN, REFERENCE_IN, FILE, *REQUIRED_ROOM, *PLAN_PORTS, *ROUTINE_PORTS,
+             ROADMAP_OUT, ROOM_OUT)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
-        self.display = RoadmapDisplay()
+        self.drawn = Drawn()
         self.log = GraphLog()
         self.graph: Roadmap | None = None
         self.room: RoomEstimate | None = None
@@ -148,9 +146,9 @@ class BuildGraph(RoutineBehaviour):
         self.priors: dict[str, EdgeMotion] = {}  # each target's own measurement from the reference
 
     def routine(self) -> Step[None]:
-        roadmap: Roadmap | None = self.get_input("roadmap", None)
-        targets: TargetImages | None = self.get_input("targets", None)
-        self.room = self.get_input("room", None)
+        roadmap = self.get_input(self.ROADMAP, None)
+        targets = self.get_input(TARGETS_IN, None)
+        self.room = self.get_input(ROOM_IN, None)
         if roadmap is None or targets is None or self.room is None:
             raise Failed("no roadmap" if roadmap is None else "no target images" if targets is None
                          else "no room estimate")
@@ -170,14 +168,15 @@ class BuildGraph(RoutineBehaviour):
         """Measure one pair; when the drive a -> b ran into something, once more from b's side."""
         self.log.tried.append((a, b))
         blocked = yield from self._pair(a, b, targets)
-        self.set_output("roadmap_out", self.graph)
+        assert self.graph is not None
+        self.set_output(self.ROADMAP_OUT, self.graph)
         if blocked and again:
             yield from self._try(b, a, targets, again=False)
 
     def _pairs(self, roadmap: Roadmap) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
         """Pairs not measured yet: those whose straight segment the room estimate knows as free, the others."""
         assert self.room is not None
-        radius = float(self.get_input("robot_radius"))
+        radius = self.get_input(ROBOT_RADIUS)
         free, unknown = [], []
         for a, b in combinations(sorted(roadmap.names), 2):
             if roadmap.motion(a, b) is not None:
@@ -263,24 +262,21 @@ class BuildGraph(RoutineBehaviour):
     def _anchor(self, reference_pose: Pose2D) -> None:
         assert self.room is not None
         self.room = reanchored(self.room, reference_pose)
-        self.set_output("room_out", self.room)
+        self.set_output(self.ROOM_OUT, self.room)
 
     def _to_reference(self, settings: HomingSettings) -> Step[None]:
+        """After a failed pair: back to the reference (a travel that runs into something, once more)."""
         assert self.room is not None
-        reference: TargetView | None = self.get_input("reference", None)
+        reference = self.get_input(REFERENCE_IN, None)
         if reference is None:
             raise Failed("an edge failed and there is no reference image to return to")
-        try:
-            yield from travel(self, self.room, Pose2D(), turn=True)
-        except Failed:  # ran into something on the way back (the map is off by the drift): once more
-            yield from travel(self, self.room, Pose2D(), turn=True)
-        result = yield from home(self, reference, settings)
+        result = yield from return_to_reference(self, self.room, reference, settings, retries=1)
         self._anchor(result.pose)
 
     def _finish(self) -> None:
         assert self.graph is not None
-        self.set_output("roadmap_out", self.graph)
-        path = self.get_input("file")
+        self.set_output(self.ROADMAP_OUT, self.graph)
+        path = self.get_input(self.FILE)
         if path:
             try:
                 relative_images(self.graph, path).save(path)
@@ -292,13 +288,13 @@ class BuildGraph(RoutineBehaviour):
             raise Failed(f"the graph is not connected: {parts}")
         self.feedback_message = f"{len(self.graph.edges)} edges, connected"
 
-    def report_sections(self) -> dict[str, Any]:
+    def figures(self) -> Iterator[Figure]:
         if self.graph is None:
-            return {}
-        section = roadmap_section(self.graph)
-        section.update({"pairs_tried": len(self.log.tried), "dropped": self.log.dropped,
-                        "not_straight": [list(p) for p in self.log.not_straight], "saved": self.log.saved})
-        return {"roadmap": section}
+            return
+        yield from roadmap_figures(roadmap_section(self.graph))
+        yield from roadmap_figures({"pairs_tried": len(self.log.tried), "dropped": self.log.dropped,
+                                    "not_straight": [list(p) for p in self.log.not_straight], "saved": self.log.saved})
 
-    def log_rerun(self, rec: Any) -> None:
-        self.display.log_roadmap(rec, self.graph)
+    def drawings(self) -> Iterator[Drawing]:
+        if self.graph is not None and self.drawn.changed("roadmap", self.graph):
+            yield from roadmap_drawings(self.graph)

@@ -49,13 +49,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.ports import InputPort, OutputPort, Port, Ref
 from behaviours.registry import register
 from behaviours.roadmap.paths import travel
+from behaviours.roadmap.room import ROOM_IN
 from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
-from behaviours.roadmap.values import HomingResult, TargetImages, TargetView
+from behaviours.roadmap.scan import MIN_INLIERS_IN
+from behaviours.roadmap.targets import TARGETS_IN
+from behaviours.roadmap.values import HomingResult, TargetView
 from behaviours.roadmap.vision import (
-    MIN_INLIERS,
     Comparison,
     camera_pose,
     compare_frame,
@@ -73,22 +75,16 @@ MAX_SIDESTEP_FAILURES = 3
 HEADING_AGREEMENT = math.radians(3.0)  # the two images must agree on the target's heading
 PLANNED_BEYOND = 0.5  # m: longer homing drives follow a planned path when the room is known
 
-HOMING_PORTS = (
-    InputPort("step", float, 0.25, unit="m", minimum=0.05, maximum=1.0,
-              doc="sidestep for the third image (paper: a step of known length)"),
-    InputPort("done_distance", float, 0.08, unit="m", minimum=0.005, maximum=1.0,
-              doc="homing ends after driving to an estimate measured from closer than this"),
-    InputPort("max_rounds", int, 5, minimum=1, maximum=20, literal_only=True,
-              doc="triangulation rounds before homing gives up"),
-    InputPort("min_inliers", int, MIN_INLIERS, minimum=8, maximum=10000, literal_only=True,
-              doc="correspondences agreeing on one planar motion for a match"),
-    InputPort("room", RoomEstimate, None, doc="room estimate (optional): sidestep towards free floor first"),
-    ROBOT_RADIUS,
-)
-REQUIRED_ROOM = (  # the homing ports of a node that cannot work without the room estimate
-    *(p for p in HOMING_PORTS if p.name != "room"),
-    InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate"),
-)
+STEP = InputPort("step", float, 0.25, unit="m", minimum=0.05, maximum=1.0,
+                 doc="sidestep for the third image (paper: a step of known length)")
+DONE_DISTANCE = InputPort("done_distance", float, 0.08, unit="m", minimum=0.005, maximum=1.0,
+                          doc="homing ends after driving to an estimate measured from closer than this")
+MAX_ROUNDS = InputPort("max_rounds", int, 5, minimum=1, maximum=20, literal_only=True,
+                       doc="triangulation rounds before homing gives up")
+ROOM_OPTIONAL = InputPort("room", RoomEstimate, None, doc="room estimate (optional): sidestep towards free floor first")
+HOMING_PORTS: tuple[Port, ...] = (STEP, DONE_DISTANCE, MAX_ROUNDS, MIN_INLIERS_IN, ROOM_OPTIONAL, ROBOT_RADIUS)
+REQUIRED_ROOM: tuple[Port, ...] = (STEP, DONE_DISTANCE, MAX_ROUNDS, MIN_INLIERS_IN, ROBOT_RADIUS, ROOM_IN)
+"""The homing ports of a node that cannot work without the room estimate."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,8 +98,14 @@ class HomingSettings:
 
     @classmethod
     def of(cls, host: RoutineBehaviour) -> HomingSettings:
-        return cls(float(host.get_input("step")), float(host.get_input("done_distance")),
-                   int(host.get_input("max_rounds")), int(host.get_input("min_inliers")))
+        return cls(host.get_input(STEP), host.get_input(DONE_DISTANCE), host.get_input(MAX_ROUNDS),
+                   host.get_input(MIN_INLIERS_IN))
+
+
+def room_of(host: RoutineBehaviour) -> RoomEstimate | None:
+    """The host's room estimate, whether it declares the room optional (``HOMING_PORTS``) or required
+    (``REQUIRED_ROOM``): both ports are named ``room``."""
+    return host.get_input(ROOM_OPTIONAL, None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -171,7 +173,7 @@ def _go(host: RoutineBehaviour, goal: Pose2D, what: str) -> Step[None]:
     """Drive to an odometry pose: along a planned path when a room estimate is known and the goal is
     farther than ``PLANNED_BEYOND`` (homing from afar must not run into the furniture in between),
     else straight."""
-    room: RoomEstimate | None = host.get_input("room", None)
+    room = room_of(host)
     here = yield from host.pose()
     if room is not None and here.distance_to(goal) > PLANNED_BEYOND:
         try:
@@ -193,7 +195,7 @@ def _step_motion(first: Look, side: int) -> tuple[float, float]:
 
 def _free_side(host: RoutineBehaviour, first: Look, settings: HomingSettings, side: int) -> int:
     """With a room estimate, the side whose sidestep ends on free floor (``side`` when both or neither)."""
-    room: RoomEstimate | None = host.get_input("room", None)
+    room = room_of(host)
     if room is None:
         return side
     free = []
@@ -203,7 +205,7 @@ def _free_side(host: RoutineBehaviour, first: Look, settings: HomingSettings, si
         end = Pose2D(first.odometry.x + sign * settings.step * math.cos(heading),
                      first.odometry.y + sign * settings.step * math.sin(heading))
         there = room.to_reference(end)
-        free.append(bool(room.free.can_stand(np.array([[there.x, there.y]]), float(host.get_input("robot_radius")))[0]))
+        free.append(bool(room.free.can_stand(np.array([[there.x, there.y]]), host.get_input(ROBOT_RADIUS))[0]))
     return -side if (free[1] and not free[0]) else side
 
 
@@ -244,17 +246,13 @@ class TargetHoming(RoutineBehaviour):
     standing there. The homing procedure is in this module's docstring.
     """
 
-    PORTS = (
-        InputPort("target", str, Ref("/map/sighting.target"), doc="name of the target to home to"),
-        InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the target images"),
-        *HOMING_PORTS,
-        *ROUTINE_PORTS,
-        OutputPort("homing", HomingResult, "/map/homing", doc="where the target is (odometry frame)"),
-    )
+    TARGET = InputPort("target", str, Ref("/map/sighting.target"), doc="name of the target to home to")
+    HOMING = OutputPort("homing", HomingResult, "/map/homing", doc="where the target is (odometry frame)")
+    PORTS = (TARGET, TARGETS_IN, *HOMING_PORTS, *ROUTINE_PORTS, HOMING)
 
     def routine(self) -> Step[None]:
-        name = self.get_input("target", None)
-        targets: TargetImages | None = self.get_input("targets", None)
+        name = self.get_input(self.TARGET, None)
+        targets = self.get_input(TARGETS_IN, None)
         if not name or targets is None:
             raise Failed("no target to home to" if not name else "no target images")
         try:
@@ -262,5 +260,5 @@ class TargetHoming(RoutineBehaviour):
         except KeyError as exc:
             raise Failed(str(exc.args[0])) from None
         result = yield from home(self, view, HomingSettings.of(self))
-        self.set_output("homing", result)
+        self.set_output(self.HOMING, result)
         self.feedback_message = f"at {name} after {result.iterations} rounds"

@@ -26,6 +26,7 @@ Choices where the paper is vague:
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import replace
 from typing import Any
 
@@ -33,11 +34,12 @@ import numpy as np
 
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
-from behaviours.roadmap.display import RoadmapDisplay
+from behaviours.roadmap.display import Drawn, roadmap_drawings, roadmap_figures
 from behaviours.roadmap.homing import HOMING_PORTS, HomingSettings, home
 from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.scan import scan
 from behaviours.roadmap.values import NavigationResult, TargetImages
+from behaviours.telemetry import Drawing, Figure
 from maps.roadmap import EdgeMotion, Roadmap
 
 
@@ -46,35 +48,34 @@ class NavigateToTarget(RoutineBehaviour):
     """From an unknown pose, reach a target of the roadmap: match a target (random moves until one
     matches), then follow the shortest path, homing at every node. Writes how it went (``navigation``)."""
 
-    PORTS = (
-        InputPort("target", str, doc="name of the target to reach"),
-        InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the learned roadmap"),
-        InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the roadmap's target images"),
-        InputPort("images", int, 12, minimum=1, maximum=72, literal_only=True,
-                  doc="images per localisation scan, evenly spaced over a full turn"),
-        InputPort("max_random_moves", int, 12, minimum=0, maximum=1000, literal_only=True,
-                  doc="random moves before giving up when no target matches"),
-        InputPort("random_distance", list[float], [0.4, 1.2], unit="m", literal_only=True,
-                  doc="shortest and longest random move"),
-        InputPort("seed", int, 0, minimum=0, literal_only=True, doc="seed of the random moves"),
-        *HOMING_PORTS,
-        *ROUTINE_PORTS,
-        OutputPort("navigation", NavigationResult, "/map/navigation", doc="how the navigation went"),
-    )
+    TARGET = InputPort("target", str, doc="name of the target to reach")
+    ROADMAP = InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the learned roadmap")
+    TARGETS = InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the roadmap's target images")
+    IMAGES = InputPort("images", int, 12, minimum=1, maximum=72, literal_only=True,
+                       doc="images per localisation scan, evenly spaced over a full turn")
+    MAX_RANDOM_MOVES = InputPort("max_random_moves", int, 12, minimum=0, maximum=1000, literal_only=True,
+                                 doc="random moves before giving up when no target matches")
+    RANDOM_DISTANCE = InputPort("random_distance", list[float], [0.4, 1.2], unit="m", literal_only=True,
+                                doc="shortest and longest random move")
+    SEED = InputPort("seed", int, 0, minimum=0, literal_only=True, doc="seed of the random moves")
+    NAVIGATION = OutputPort("navigation", NavigationResult, "/map/navigation", doc="how the navigation went")
+    PORTS = (TARGET, ROADMAP, TARGETS, IMAGES, MAX_RANDOM_MOVES, RANDOM_DISTANCE, SEED, *HOMING_PORTS,
+             *ROUTINE_PORTS, NAVIGATION)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
-        low_high = self.inputs["random_distance"]
+        low_high = self.get_input(self.RANDOM_DISTANCE)
         if len(low_high) != 2 or not 0 <= low_high[0] <= low_high[1]:
             raise ValueError(f"NavigateToTarget.random_distance takes [shortest, longest], got {low_high}")
+        self.random_distance: tuple[float, float] = (low_high[0], low_high[1])
         self.result: NavigationResult | None = None
         self.rng = np.random.default_rng(0)  # re-seeded from the seed port when the routine starts
-        self.display = RoadmapDisplay()
+        self.drawn = Drawn()
 
     def routine(self) -> Step[None]:
-        goal = str(self.get_input("target"))
-        roadmap: Roadmap | None = self.get_input("roadmap", None)
-        targets: TargetImages | None = self.get_input("targets", None)
+        goal = self.get_input(self.TARGET)
+        roadmap = self.get_input(self.ROADMAP, None)
+        targets = self.get_input(self.TARGETS, None)
         if roadmap is None or targets is None:
             raise Failed("no roadmap" if roadmap is None else "no target images")
         if not goal:
@@ -82,7 +83,7 @@ class NavigateToTarget(RoutineBehaviour):
         if goal not in roadmap.names or goal not in targets.names:
             raise Failed(f"no target named {goal!r} in the roadmap (it has: {', '.join(roadmap.names)})")
         self.result = NavigationResult(goal, False)
-        self.rng = np.random.default_rng(int(self.get_input("seed")))
+        self.rng = np.random.default_rng(self.get_input(self.SEED))
         try:
             yield from self._navigate(goal, roadmap, targets)
         except Failed as exc:
@@ -110,9 +111,9 @@ class NavigateToTarget(RoutineBehaviour):
     def _localise(self, targets: TargetImages) -> Step[str]:
         """Scan, move randomly when nothing matches, home to the first target matched: its name."""
         settings = HomingSettings.of(self)
-        limit = int(self.get_input("max_random_moves"))
+        limit = self.get_input(self.MAX_RANDOM_MOVES)
         for attempt in range(limit + 1):
-            sighting, _ = yield from scan(self, targets.views, int(self.get_input("images")), settings.min_inliers)
+            sighting, _ = yield from scan(self, targets.views, self.get_input(self.IMAGES), settings.min_inliers)
             if sighting is not None:
                 try:
                     yield from home(self, targets.get(sighting.target), settings)
@@ -126,7 +127,7 @@ class NavigateToTarget(RoutineBehaviour):
         raise Failed(f"no target matched after {limit} random moves")
 
     def _random_move(self) -> Step[None]:
-        low, high = self.inputs["random_distance"]
+        low, high = self.random_distance
         turn, distance = self.rng.uniform(-math.pi, math.pi), self.rng.uniform(low, high)
         assert self.result is not None
         self._note(random_moves=self.result.random_moves + 1)
@@ -152,15 +153,16 @@ class NavigateToTarget(RoutineBehaviour):
     def _note(self, **changes: Any) -> None:
         assert self.result is not None
         self.result = replace(self.result, **changes)
-        self.set_output("navigation", self.result)
+        self.set_output(self.NAVIGATION, self.result)
 
-    def report_sections(self) -> dict[str, Any]:
-        if self.result is None:
-            return {}
+    def figures(self) -> Iterator[Figure]:
         r = self.result
-        return {"roadmap": {"navigation": {"goal": r.goal, "reached": r.reached, "localised_at": r.localised_at,
-                                           "visited": list(r.visited), "random_moves": r.random_moves,
-                                           "rescans": r.rescans, "reason": r.reason}}}
+        if r is not None:
+            yield from roadmap_figures({"goal": r.goal, "reached": r.reached, "localised_at": r.localised_at,
+                                        "visited": list(r.visited), "random_moves": r.random_moves,
+                                        "rescans": r.rescans, "reason": r.reason}, "navigation")
 
-    def log_rerun(self, rec: Any) -> None:
-        self.display.log_roadmap(rec, self.get_input("roadmap", None))
+    def drawings(self) -> Iterator[Drawing]:
+        roadmap = self.get_input(self.ROADMAP, None)
+        if roadmap is not None and self.drawn.changed("roadmap", roadmap):
+            yield from roadmap_drawings(roadmap)

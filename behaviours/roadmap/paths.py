@@ -23,13 +23,20 @@ import math
 
 import numpy as np
 
-from behaviours.roadmap.routine import Failed, RoutineBehaviour, Step
+from behaviours.ports import InputPort, OutputPort, Port
+from behaviours.roadmap.routine import ROBOT_RADIUS, Failed, RoutineBehaviour, Step
 from maps.planning import PlanResult, plan_path
 from maps.room import FreeGrid, RoomEstimate
 from perception.geometry import Pose2D
 
 SNAP = 0.6  # m: farthest a start or goal is moved to reach standable floor
 PLAN_TIME = 0.5  # s: default time limit of a path search
+
+PLAN_TIME_IN = InputPort("plan_time", float, PLAN_TIME, unit="s", minimum=0.01, maximum=10.0, literal_only=True,
+                         doc="time limit of one path search (wall clock, inside one tick)")
+PLAN_OUT = OutputPort("plan", PlanResult, "/map/plan", doc="the last planned path (reference frame)")
+PLAN_PORTS: tuple[Port, ...] = (PLAN_TIME_IN, PLAN_OUT)
+"""The ports of a node that plans; a routine without them plans within ``PLAN_TIME`` and writes no plan."""
 
 
 def nearest_standable(free: FreeGrid, x: float, y: float, radius: float, snap: float = SNAP
@@ -59,18 +66,18 @@ def plan(host: RoutineBehaviour, room: RoomEstimate, goal: Pose2D) -> Step[PlanR
 
     Written to the host's ``plan`` output when it has one; :class:`Failed` when there is none.
     """
-    radius = float(host.get_input("robot_radius"))
+    radius = host.get_input(ROBOT_RADIUS)
     here = room.to_reference((yield from host.pose()))
     start = nearest_standable(room.free, here.x, here.y, radius, snap=math.inf)  # the robot is on free floor
     end = nearest_standable(room.free, goal.x, goal.y, radius)
     if start is None or end is None:
         what = "robot" if start is None else "goal"
         raise Failed(f"no path: the {what} is more than {SNAP} m from floor where the robot may stand")
-    limit = float(host.get_input("plan_time")) if "plan_time" in host.inputs else PLAN_TIME
+    limit = host.get_input(PLAN_TIME_IN) if PLAN_TIME_IN.name in host.inputs else PLAN_TIME
     result = plan_path(room.free, Pose2D(start[0], start[1], here.theta), Pose2D(end[0], end[1], goal.theta),
                        robot_radius=radius, time_limit=limit)
-    if "plan" in host.outputs:
-        host.set_output("plan", result)
+    if PLAN_OUT.name in host.outputs:
+        host.set_output(PLAN_OUT, result)
     if not result.ok:
         raise Failed(result.reason)
     return result

@@ -29,21 +29,26 @@ Choices where the paper is vague:
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 
-from behaviours.ports import InputPort, OutputPort
+from behaviours.motion import ODOMETRY
+from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
-from behaviours.roadmap.display import RoadmapDisplay, room_section
-from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.display import Drawn, roadmap_figures, robot_drawings, room_drawings, room_section
+from behaviours.roadmap.routine import CAMERA, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.values import TargetView
 from behaviours.roadmap.vision import describe
+from behaviours.telemetry import Drawing, Figure
 from maps.room import CORNERS, RigMount, RoomEstimate, RoomEstimateError, RoomParams, StereoView, estimate_room
 from perception.frame import Frame
 from perception.stereo import dense_depth, dense_points, sparse_stereo
 
 REFERENCE_NAME = "reference"
+
+ROOM_IN = InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate")
 
 
 def stereo_points(frame: Frame, method: str) -> np.ndarray:
@@ -66,51 +71,49 @@ class RoomEstimationDodecagon(RoutineBehaviour):
     image at the reference corner). FAILURE when the views do not enclose the room.
     """
 
-    PORTS = (
-        InputPort("side", float, 0.25, unit="m", minimum=0.05, maximum=2.0,
-                  doc="side of the dodecagon (corners on a circle of radius 1.93 x side)"),
-        InputPort("stereo_camera", str, "stereo", literal_only=True, doc="the stereo camera on the pan-tilt head"),
-        InputPort("stereo", str, "dense", choices=("dense", "sparse"), literal_only=True,
-                  doc="stereo matching: dense (SGBM) or sparse (features along epipolar lines)"),
-        InputPort("rig_height", float, 1.08, unit="m", minimum=0.05, maximum=5.0, literal_only=True,
-                  doc="height of the stereo rig's optical centre above the floor"),
-        InputPort("pan_axis", list[float], [0.1, 0.0], unit="m", literal_only=True,
-                  doc="the pan axis on the robot (x forward, y left)"),
-        InputPort("rig_offset", list[float], [0.05, 0.0], unit="m", literal_only=True,
-                  doc="the rig's left camera on the pan head (x forward, y left)"),
-        InputPort("max_obstacle_height", float, 2.0, unit="m", minimum=0.1, maximum=100.0, literal_only=True,
-                  doc="higher points are overhangs (or the ceiling), not obstacles"),
-        InputPort("support", int, 30, minimum=1, maximum=10000, literal_only=True,
-                  doc="a polygon vertex is the support-th nearest obstacle point of its direction"),
-        *ROUTINE_PORTS,
-        OutputPort("room", RoomEstimate, "/map/room", doc="the room estimate (reference frame)"),
-        OutputPort("reference", TargetView, "/map/reference_image", doc="the image taken at the reference pose"),
-    )
+    SIDE = InputPort("side", float, 0.25, unit="m", minimum=0.05, maximum=2.0,
+                     doc="side of the dodecagon (corners on a circle of radius 1.93 x side)")
+    STEREO_CAMERA = InputPort("stereo_camera", str, "stereo", literal_only=True,
+                              doc="the stereo camera on the pan-tilt head")
+    STEREO = InputPort("stereo", str, "dense", choices=("dense", "sparse"), literal_only=True,
+                       doc="stereo matching: dense (SGBM) or sparse (features along epipolar lines)")
+    RIG_HEIGHT = InputPort("rig_height", float, 1.08, unit="m", minimum=0.05, maximum=5.0, literal_only=True,
+                           doc="height of the stereo rig's optical centre above the floor")
+    PAN_AXIS = InputPort("pan_axis", list[float], [0.1, 0.0], unit="m", literal_only=True,
+                         doc="the pan axis on the robot (x forward, y left)")
+    RIG_OFFSET = InputPort("rig_offset", list[float], [0.05, 0.0], unit="m", literal_only=True,
+                           doc="the rig's left camera on the pan head (x forward, y left)")
+    MAX_OBSTACLE_HEIGHT = InputPort("max_obstacle_height", float, 2.0, unit="m", minimum=0.1, maximum=100.0,
+                                    literal_only=True,
+                                    doc="higher points are overhangs (or the ceiling), not obstacles")
+    SUPPORT = InputPort("support", int, 30, minimum=1, maximum=10000, literal_only=True,
+                        doc="a polygon vertex is the support-th nearest obstacle point of its direction")
+    ROOM = OutputPort("room", RoomEstimate, "/map/room", doc="the room estimate (reference frame)")
+    REFERENCE = OutputPort("reference", TargetView, "/map/reference_image", doc="the image taken at the reference pose")
+    PORTS = (SIDE, STEREO_CAMERA, STEREO, RIG_HEIGHT, PAN_AXIS, RIG_OFFSET, MAX_OBSTACLE_HEIGHT, SUPPORT,
+             *ROUTINE_PORTS, ROOM, REFERENCE)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
-        for port in ("pan_axis", "rig_offset"):
-            if len(self.inputs[port]) != 2:
-                raise ValueError(f"{type(self).__name__}.{port} takes [x, y], got {self.inputs[port]}")
-        self.display = RoadmapDisplay()
+        self.pan_axis, self.rig_offset = self.pair(self.PAN_AXIS), self.pair(self.RIG_OFFSET)
+        self.drawn = Drawn()
         self._points: list[int] = []
         self._features: list[int] = []
 
     def mount(self) -> RigMount:
-        axis, offset = self.inputs["pan_axis"], self.inputs["rig_offset"]
-        return RigMount(float(self.get_input("rig_height")), (axis[0], axis[1]), (offset[0], offset[1]))
+        return RigMount(self.get_input(self.RIG_HEIGHT), self.pan_axis, self.rig_offset)
 
     def routine(self) -> Step[None]:
-        stereo, camera = self.get_input("stereo_camera"), self.get_input("camera")
+        stereo, camera = self.get_input(self.STEREO_CAMERA), self.get_input(CAMERA)
         views: list[StereoView] = []
         images: list[TargetView] = []
         self._points, self._features = [], []
         for corner in range(CORNERS):
             if corner:  # paper: take the pair, turn 30 degrees, drive to the next corner
                 yield from self.rotate(2.0 * math.pi / CORNERS, f"turning at corner {corner}")
-                yield from self.drive(float(self.get_input("side")), f"driving to corner {corner + 1}")
+                yield from self.drive(self.get_input(self.SIDE), f"driving to corner {corner + 1}")
             frames, pose = yield from self.capture_all((stereo, camera))
-            points = stereo_points(frames[stereo], self.get_input("stereo"))
+            points = stereo_points(frames[stereo], self.get_input(self.STEREO))
             features = describe(frames[camera].image)
             views.append(StereoView(pose, 0.0, points, features=len(features)))
             images.append(TargetView(REFERENCE_NAME, frames[camera].image, features, frames[camera].camera,
@@ -119,25 +122,30 @@ class RoomEstimationDodecagon(RoutineBehaviour):
             self._features.append(len(features))
             self.feedback_message = f"corner {corner + 1}: {len(points)} stereo points, {len(features)} features"
             yield  # one corner's image work per tick
-        params = RoomParams(support=int(self.get_input("support")),
-                            max_obstacle_height=float(self.get_input("max_obstacle_height")))
+        params = RoomParams(support=self.get_input(self.SUPPORT),
+                            max_obstacle_height=self.get_input(self.MAX_OBSTACLE_HEIGHT))
         try:
             room = estimate_room(views, self.mount(), params)
         except RoomEstimateError as exc:
             raise Failed(f"room estimate: {exc}") from None
-        self.set_output("room", room)
-        self.set_output("reference", images[room.reference_index])
+        self.set_output(self.ROOM, room)
+        self.set_output(self.REFERENCE, images[room.reference_index])
         self.feedback_message = f"free floor {room.free.free.sum() * room.free.cell ** 2:.1f} m2, reference corner " \
                                 f"{room.reference_index + 1}"
 
-    def report_sections(self) -> dict[str, Any]:
-        room, reference = self.written("room"), self.written("reference")
-        if room is None:
-            return {}
-        stamp = reference.stamp if reference is not None else math.nan
-        return {"roadmap": {"room": room_section(room, self._points, self._features, stamp)}}
+    def figures(self) -> Iterator[Figure]:
+        room, reference = self.written(self.ROOM), self.written(self.REFERENCE)
+        if room is not None:
+            stamp = reference.stamp if reference is not None else math.nan
+            yield from roadmap_figures(room_section(room, self._points, self._features, stamp), "room")
 
-    def log_rerun(self, rec: Any) -> None:
-        room = self.written("room")
-        self.display.log_room(rec, room)
-        self.display.log_robot(rec, room, self.get_input("odometry", None))
+    def drawings(self) -> Iterator[Drawing]:
+        """The room when it is estimated (re-anchoring keeps the map: not again), the robot in it every time."""
+        room = self.written(self.ROOM)
+        if room is None:
+            return
+        if self.drawn.changed("room", room.polygon):
+            yield from room_drawings(room)
+        odometry = self.get_input(ODOMETRY, None)
+        if odometry is not None:
+            yield from robot_drawings(room, odometry)

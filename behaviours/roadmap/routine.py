@@ -74,13 +74,17 @@ class RoutineBehaviour(BearingsBehaviour):
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
-        offset = self.inputs["camera_offset"]
-        if len(offset) != 2:
-            raise ValueError(f"{type(self).__name__}.camera_offset takes [x, y], got {offset}")
-        self.camera_offset: tuple[float, float] = (float(offset[0]), float(offset[1]))
+        self.camera_offset = self.pair(CAMERA_OFFSET)
         self._routine: Step[None] | None = None
         self._motion: BearingsBehaviour | None = None
         self._last_direction = 1.0  # sign of the last drive: a stall is backed away from the other way
+
+    def pair(self, port: InputPort[list[float]]) -> tuple[float, float]:
+        """A literal ``[x, y]`` port (a position on the robot); ValueError naming the port otherwise."""
+        value = self.get_input(port)
+        if len(value) != 2:
+            raise ValueError(f"{type(self).__name__}.{port.name} takes [x, y], got {value}")
+        return value[0], value[1]
 
     # -- the coroutine ---------------------------------------------------------------------
     def routine(self) -> Step[None]:
@@ -110,9 +114,9 @@ class RoutineBehaviour(BearingsBehaviour):
             self._routine.close()
             self._routine = None
         if new_status != Status.RUNNING:
-            self.set_output("command", STOP)
+            self.set_output(COMMAND, STOP)
 
-    def written(self, port: str) -> Any:
+    def written(self, port: OutputPort[T]) -> T | None:
         """What this node last wrote to an output port (None before it wrote), for reports and views."""
         try:
             return self.bb.get(self.output_key(port))
@@ -146,8 +150,9 @@ class RoutineBehaviour(BearingsBehaviour):
             self._motion = None
 
     def _bound(self) -> dict[str, Any]:
-        return {"odometry": self.inputs["odometry"], "stalled": self.inputs["stalled"],
-                "command": self.outputs["command"]}
+        """This node's motion ports as bound (literal, reference or remapped key), for a motion node."""
+        return {ODOMETRY.name: self.inputs[ODOMETRY.name], STALLED.name: self.inputs[STALLED.name],
+                COMMAND.name: self.output_key(COMMAND)}
 
     def rotate(self, angle: float, what: str = "turning") -> Step[None]:
         """Turn on the spot by ``angle`` (rad, counter-clockwise) with :class:`~behaviours.motion.Rotate`.
@@ -156,8 +161,8 @@ class RoutineBehaviour(BearingsBehaviour):
         flag a contact left must not stop the turn that leads away from it."""
         if abs(angle) < MIN_TURN:
             return
-        bound = {**self._bound(), "stalled": False}
-        rate = float(self.get_input("turn_speed"))
+        bound = {**self._bound(), STALLED.name: False}
+        rate = self.get_input(TURN_SPEED)
         node = Rotate(name=f"{self.name}: {what}", angle=math.degrees(angle), speed=rate, tolerance=0.5, **bound)
         yield from self.run_motion(node, what, abs(math.degrees(angle)) / rate)
 
@@ -172,11 +177,11 @@ class RoutineBehaviour(BearingsBehaviour):
             return
         bound = self._bound()
         if ignore_stall:
-            bound["stalled"] = False  # backing away from a contact: the stall flag stays up until it moves
+            bound[STALLED.name] = False  # backing away from a contact: the stall flag stays up until it moves
         else:
             yield from self._clear_stall()
             self._last_direction = math.copysign(1.0, distance)
-        speed = float(self.get_input("speed"))
+        speed = self.get_input(SPEED)
         node = Drive(name=f"{self.name}: {what}", distance=distance, speed=speed, **bound)
         yield from self.run_motion(node, what, abs(distance) / speed)
 
@@ -191,11 +196,11 @@ class RoutineBehaviour(BearingsBehaviour):
         yield from self.turn_to(math.atan2(y - pose.y, x - pose.x), what)
         pose = yield from self.pose()
         self._last_direction = 1.0
-        speed = float(self.get_input("speed"))
+        speed = self.get_input(SPEED)
         node = DriveTo(name=f"{self.name}: {what}", x=x, y=y, speed=speed, tolerance=tolerance, **self._bound())
         turn = abs(wrap_angle(math.atan2(y - pose.y, x - pose.x) - pose.theta))
         yield from self.run_motion(node, what, math.hypot(x - pose.x, y - pose.y) / speed
-                                   + math.degrees(turn) / float(self.get_input("turn_speed")))
+                                   + math.degrees(turn) / self.get_input(TURN_SPEED))
 
     def go_to_pose(self, pose: Pose2D, what: str = "driving") -> Step[None]:
         """Drive to an odometry pose: to its position, then turn to its heading."""
@@ -209,14 +214,14 @@ class RoutineBehaviour(BearingsBehaviour):
 
     def _clear_stall(self) -> Step[None]:
         """Before a drive: a stall flag still up from an earlier contact is backed away from first."""
-        if self.get_input("stalled", False):
+        if self.get_input(STALLED, False):
             yield from self.back_off()
 
     # -- state and images -------------------------------------------------------------------------
     def pose(self) -> Step[Pose2D]:
         """The odometry pose (waits for the first reading)."""
         while True:
-            pose = self.get_input("odometry", None)
+            pose = self.get_input(ODOMETRY, None)
             if pose is not None:
                 return pose
             self.feedback_message = "waiting for odometry"
@@ -226,19 +231,19 @@ class RoutineBehaviour(BearingsBehaviour):
         """Bring the pan-tilt head to pan 0, tilt 0 (nothing to do without one)."""
         deadline = self.now() + HEAD_TIMEOUT
         while True:
-            state = self.get_input("ptu", None)
+            state = self.get_input(HEAD, None)
             if state is None or (abs(state.pan) <= HEAD_TOLERANCE and abs(state.tilt) <= HEAD_TOLERANCE
                                  and not state.moving):
                 return
             if self.now() > deadline:
                 raise Failed("the pan-tilt head does not reach pan 0, tilt 0")
-            self.set_output("ptu_command", PanTiltCommand(0.0, 0.0, HEAD_SPEED))
+            self.set_output(HEAD_COMMAND, PanTiltCommand(0.0, 0.0, HEAD_SPEED))
             yield
 
     def capture(self, camera: str | None = None) -> Step[tuple[Frame, Pose2D]]:
         """The next image of ``camera`` (default: the ``camera`` port) taken at rest, and the odometry
         pose it was taken from (see :meth:`capture_all`)."""
-        name = camera or self.get_input("camera")
+        name = camera or self.get_input(CAMERA)
         frames, pose = yield from self.capture_all((name,))
         return frames[name], pose
 
@@ -247,12 +252,12 @@ class RoutineBehaviour(BearingsBehaviour):
         the head is level, the odometry has not moved for a tick and ``settle`` seconds have passed,
         then for frames stamped after that."""
         yield from self.level_head()
-        settle = float(self.get_input("settle"))
+        settle = self.get_input(SETTLE)
         start = self.now()
         last: Pose2D | None = None
         while True:
-            pose = self.get_input("odometry", None)
-            frames = self.get_input("frames", None) or {}
+            pose = self.get_input(ODOMETRY, None)
+            frames = self.get_input(FRAMES, None) or {}
             fresh = {n: f for n in cameras
                      if isinstance(f := frames.get(n), Frame) and f.stamp >= start + settle - 1e-6}
             if last is not None and pose is not None and _same_place(pose, last) and len(fresh) == len(cameras):

@@ -28,20 +28,16 @@ from typing import Any
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
-from behaviours.roadmap.values import ScanRecord, Sighting, TargetImages, TargetView
+from behaviours.roadmap.targets import TARGETS_IN
+from behaviours.roadmap.values import ScanRecord, Sighting, TargetView
 from behaviours.roadmap.vision import MIN_INLIERS, Comparison, compare, describe
 from maps.roadmap import Roadmap
 from maps.room import RoomEstimate
 from perception.geometry import Pose2D
 
-SCAN_PORTS = (
-    InputPort("images", int, 12, minimum=1, maximum=72, literal_only=True,
-              doc="images per position, evenly spaced over a full turn (paper: 12)"),
-    InputPort("min_inliers", int, MIN_INLIERS, minimum=8, maximum=10000, literal_only=True,
-              doc="correspondences agreeing on one planar motion for a match"),
-    InputPort("unwind", bool, True, literal_only=True,
-              doc="after a scan that found nothing, turn back to the first heading (no net turn)"),
-)
+MIN_INLIERS_IN = InputPort("min_inliers", int, MIN_INLIERS, minimum=8, maximum=10000, literal_only=True,
+                           doc="correspondences agreeing on one planar motion for a match")
+"""How many inliers make a match, for scans and homing alike."""
 
 
 def best_match(host: RoutineBehaviour, candidates: Sequence[TargetView], min_inliers: int
@@ -94,15 +90,15 @@ class ScanForTargets(RoutineBehaviour):
     ``CoverageScoring`` marks as covered.
     """
 
-    PORTS = (
-        *SCAN_PORTS,
-        InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the target images"),
-        InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="targets already found (skipped)"),
-        InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate (for the scan record)"),
-        *ROUTINE_PORTS,
-        OutputPort("sighting", Sighting, "/map/sighting", doc="the target matched and where from"),
-        OutputPort("scan", ScanRecord, "/map/scan", doc="the position and headings imaged (reference frame)"),
-    )
+    IMAGES = InputPort("images", int, 12, minimum=1, maximum=72, literal_only=True,
+                       doc="images per position, evenly spaced over a full turn (paper: 12)")
+    UNWIND = InputPort("unwind", bool, True, literal_only=True,
+                       doc="after a scan that found nothing, turn back to the first heading (no net turn)")
+    ROADMAP = InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="targets already found (skipped)")
+    ROOM = InputPort("room", RoomEstimate, Ref("/map/room"), doc="the room estimate (for the scan record)")
+    SIGHTING = OutputPort("sighting", Sighting, "/map/sighting", doc="the target matched and where from")
+    SCAN = OutputPort("scan", ScanRecord, "/map/scan", doc="the position and headings imaged (reference frame)")
+    PORTS = (IMAGES, MIN_INLIERS_IN, UNWIND, TARGETS_IN, ROADMAP, ROOM, *ROUTINE_PORTS, SIGHTING, SCAN)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -110,26 +106,27 @@ class ScanForTargets(RoutineBehaviour):
         self.last: tuple[str, Pose2D] | None = None  # the last sighting: target, where from (reference frame)
 
     def routine(self) -> Step[None]:
-        targets: TargetImages | None = self.get_input("targets", None)
-        room: RoomEstimate | None = self.get_input("room", None)
+        targets = self.get_input(TARGETS_IN, None)
+        room = self.get_input(self.ROOM, None)
         if targets is None or room is None:
             raise Failed("no target images" if targets is None else "no room estimate")
-        roadmap: Roadmap | None = self.get_input("roadmap", None)
+        roadmap = self.get_input(self.ROADMAP, None)
         found = set(roadmap.names) if roadmap is not None else set()
         here = room.to_reference((yield from self.pose()))
         candidates = [v for v in targets.views if v.name not in found and not self._failed_here(v.name, here)]
         if not candidates:
             raise Failed("every target is found already" if not set(targets.names) - found else
                          f"no target left to look for from ({here.x:.1f}, {here.y:.1f})")
-        sighting, poses = yield from scan(self, candidates, int(self.get_input("images")),
-                                          int(self.get_input("min_inliers")), unwind=bool(self.get_input("unwind")))
+        sighting, poses = yield from scan(self, candidates, self.get_input(self.IMAGES),
+                                          self.get_input(MIN_INLIERS_IN), unwind=self.get_input(self.UNWIND))
         self.scans += 1
         headings = tuple(room.to_reference(p).theta for p in poses)
-        self.set_output("scan", ScanRecord(self.scans, here.x, here.y, headings, sighting.target if sighting else ""))
+        seen = sighting.target if sighting else ""
+        self.set_output(self.SCAN, ScanRecord(self.scans, here.x, here.y, headings, seen))
         if sighting is None:
             raise Failed(f"no target in sight from ({here.x:.1f}, {here.y:.1f})")
         self.last = (sighting.target, here)
-        self.set_output("sighting", sighting)
+        self.set_output(self.SIGHTING, sighting)
         self.feedback_message = f"{sighting.target} in sight ({sighting.inliers} inliers)"
 
     def _failed_here(self, name: str, here: Pose2D) -> bool:

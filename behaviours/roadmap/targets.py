@@ -14,6 +14,7 @@ drift of one trip instead of a whole search).
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -24,9 +25,10 @@ from py_trees.common import Status
 from behaviours.base import BearingsBehaviour
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
-from behaviours.roadmap.display import RoadmapDisplay, roadmap_section
+from behaviours.roadmap.display import Drawn, roadmap_drawings, roadmap_figures, roadmap_section
 from behaviours.roadmap.values import HomingResult, TargetImages, TargetView
 from behaviours.roadmap.vision import FEATURES, describe
+from behaviours.telemetry import Drawing, Figure
 from maps.roadmap import Roadmap, Target
 from maps.room import RoomEstimate
 from maps.store import InputError, read_bytes
@@ -34,6 +36,11 @@ from maps.store import InputError, read_bytes
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".pgm", ".ppm", ".tif", ".tiff")
 MAX_IMAGE_BYTES = 64 * 1024 * 1024
 MAX_TARGETS = 100
+
+MAX_FEATURES = InputPort("max_features", int, FEATURES, minimum=50, maximum=20000, literal_only=True,
+                         doc="SIFT features per image")
+TARGETS_OUT = OutputPort("targets", TargetImages, "/map/target_images", doc="the target images with their features")
+TARGETS_IN = InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the target images")
 
 
 def read_image(path: str | os.PathLike) -> np.ndarray:
@@ -78,21 +85,17 @@ class LoadTargetImages(BearingsBehaviour):
     FAILURE, saying why, when the folder is missing or empty or an image cannot be read.
     """
 
-    PORTS = (
-        InputPort("folder", str, doc="folder of target images (PNG, JPEG, ...); target name = file name"),
-        InputPort("max_features", int, FEATURES, minimum=50, maximum=20000, literal_only=True,
-                  doc="SIFT features per image"),
-        OutputPort("targets", TargetImages, "/map/target_images", doc="the target images with their features"),
-    )
+    FOLDER = InputPort("folder", str, doc="folder of target images (PNG, JPEG, ...); target name = file name")
+    PORTS = (FOLDER, MAX_FEATURES, TARGETS_OUT)
 
     def update(self) -> Status:
         try:
-            files = image_files(self.get_input("folder"))
-            views = tuple(target_view(p.stem, p.resolve(), self.get_input("max_features")) for p in files)
+            files = image_files(self.get_input(self.FOLDER))
+            views = tuple(target_view(p.stem, p.resolve(), self.get_input(MAX_FEATURES)) for p in files)
         except ValueError as exc:
             self.feedback_message = str(exc)
             return Status.FAILURE
-        self.set_output("targets", TargetImages(views))
+        self.set_output(TARGETS_OUT, TargetImages(views))
         self.feedback_message = f"{len(views)} targets: {', '.join(v.name for v in views)}"
         return Status.SUCCESS
 
@@ -101,19 +104,15 @@ class LoadTargetImages(BearingsBehaviour):
 class LoadRoadmap(BearingsBehaviour):
     """Read a roadmap file and the target images it names (paths relative to the file's folder)."""
 
-    PORTS = (
-        InputPort("file", str, doc="roadmap file written by learn_targets"),
-        InputPort("max_features", int, FEATURES, minimum=50, maximum=20000, literal_only=True,
-                  doc="SIFT features per image"),
-        OutputPort("roadmap", Roadmap, "/map/roadmap", doc="targets (reference frame) and edges"),
-        OutputPort("targets", TargetImages, "/map/target_images", doc="the target images with their features"),
-    )
+    FILE = InputPort("file", str, doc="roadmap file written by learn_targets")
+    ROADMAP = OutputPort("roadmap", Roadmap, "/map/roadmap", doc="targets (reference frame) and edges")
+    PORTS = (FILE, MAX_FEATURES, ROADMAP, TARGETS_OUT)
 
     def update(self) -> Status:
-        path = Path(self.get_input("file"))
+        path = Path(self.get_input(self.FILE))
         try:
             roadmap = Roadmap.load(path)
-            views = tuple(target_view(t.name, resolve_image(path, t.image), self.get_input("max_features"))
+            views = tuple(target_view(t.name, resolve_image(path, t.image), self.get_input(MAX_FEATURES))
                           for t in roadmap.targets)
         except InputError as exc:
             self.feedback_message = str(exc.diagnostics[0])
@@ -121,8 +120,8 @@ class LoadRoadmap(BearingsBehaviour):
         except ValueError as exc:
             self.feedback_message = str(exc)
             return Status.FAILURE
-        self.set_output("roadmap", roadmap)
-        self.set_output("targets", TargetImages(views))
+        self.set_output(self.ROADMAP, roadmap)
+        self.set_output(TARGETS_OUT, TargetImages(views))
         self.feedback_message = f"{len(roadmap.targets)} targets, {len(roadmap.edges)} edges"
         return Status.SUCCESS
 
@@ -152,40 +151,41 @@ class RecordTarget(BearingsBehaviour):
     why this runs after the return.
     """
 
-    PORTS = (
-        InputPort("homing", HomingResult, Ref("/map/homing"), doc="where the target is (odometry frame)"),
-        InputPort("room", RoomEstimate, Ref("/map/room"), doc="room estimate: the reference pose in odometry"),
-        InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the target images"),
-        InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the roadmap so far (none yet: empty)"),
-        OutputPort("roadmap_out", Roadmap, "/map/roadmap", doc="the roadmap with this target"),
-    )
+    HOMING = InputPort("homing", HomingResult, Ref("/map/homing"), doc="where the target is (odometry frame)")
+    ROOM = InputPort("room", RoomEstimate, Ref("/map/room"), doc="room estimate: the reference pose in odometry")
+    ROADMAP = InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the roadmap so far (none yet: empty)")
+    ROADMAP_OUT = OutputPort("roadmap_out", Roadmap, "/map/roadmap", doc="the roadmap with this target")
+    PORTS = (HOMING, ROOM, TARGETS_IN, ROADMAP, ROADMAP_OUT)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
-        self.display = RoadmapDisplay()
+        self.drawn = Drawn()
 
     def update(self) -> Status:
-        homing: HomingResult | None = self.get_input("homing", None)
-        room: RoomEstimate | None = self.get_input("room", None)
+        homing = self.get_input(self.HOMING, None)
+        room = self.get_input(self.ROOM, None)
         if homing is None or room is None:
             self.feedback_message = "no homing result" if homing is None else "no room estimate"
             return Status.FAILURE
-        roadmap: Roadmap = self.get_input("roadmap", None) or Roadmap()
-        targets: TargetImages | None = self.get_input("targets", None)
+        roadmap = self.get_input(self.ROADMAP, None) or Roadmap()
+        targets = self.get_input(TARGETS_IN, None)
         image = ""
         if targets is not None and homing.target in targets.names:
             image = targets.get(homing.target).source
         pose = room.to_reference(homing.pose)
-        self.set_output("roadmap_out", roadmap.with_target(homing.target, pose, image))
+        self.set_output(self.ROADMAP_OUT, roadmap.with_target(homing.target, pose, image))
         self.feedback_message = f"{homing.target} at ({pose.x:.2f}, {pose.y:.2f})"
         return Status.SUCCESS
 
-    def report_sections(self) -> dict[str, Any]:
-        roadmap = self.get_input("roadmap", None)
-        return {"roadmap": roadmap_section(roadmap)} if roadmap is not None else {}
+    def figures(self) -> Iterator[Figure]:
+        roadmap = self.get_input(self.ROADMAP, None)
+        if roadmap is not None:
+            yield from roadmap_figures(roadmap_section(roadmap))
 
-    def log_rerun(self, rec: Any) -> None:
-        self.display.log_roadmap(rec, self.get_input("roadmap", None))
+    def drawings(self) -> Iterator[Drawing]:
+        roadmap = self.get_input(self.ROADMAP, None)
+        if roadmap is not None and self.drawn.changed("roadmap", roadmap):
+            yield from roadmap_drawings(roadmap)
 
 
 @register
@@ -193,14 +193,12 @@ class AllTargetsFound(BearingsBehaviour):
     """SUCCESS when every target image has a place in the roadmap, FAILURE otherwise."""
 
     KIND = "condition"
-    PORTS = (
-        InputPort("targets", TargetImages, Ref("/map/target_images"), doc="the target images"),
-        InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the roadmap so far"),
-    )
+    ROADMAP = InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the roadmap so far")
+    PORTS = (TARGETS_IN, ROADMAP)
 
     def update(self) -> Status:
-        targets: TargetImages | None = self.get_input("targets", None)
-        roadmap: Roadmap | None = self.get_input("roadmap", None)
+        targets = self.get_input(TARGETS_IN, None)
+        roadmap = self.get_input(self.ROADMAP, None)
         if targets is None:
             self.feedback_message = "no target images"
             return Status.FAILURE

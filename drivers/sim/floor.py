@@ -64,6 +64,13 @@ class FloorGrid:
         inside = (rows >= 0) & (rows < self.free.shape[0]) & (cols >= 0) & (cols < self.free.shape[1])
         return rows, cols, inside
 
+    def reachable_at(self, xy: np.ndarray) -> np.ndarray:
+        """Whether each world point (N x 2) is on :attr:`reachable` (False off the grid)."""
+        rows, cols, inside = self.cells_of(xy)
+        ok = np.zeros(len(rows), dtype=bool)
+        ok[inside] = self.reachable[rows[inside], cols[inside]]
+        return ok
+
     def coverage(self, explored_xy: np.ndarray, mask: str = "reachable") -> float:
         """Fraction of ``mask`` (``reachable`` or ``floor``) with an explored world point in its cell.
 

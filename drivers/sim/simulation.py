@@ -205,7 +205,7 @@ class Simulation:
 
     def odometry_in_world(self) -> np.ndarray:
         """Where odometry believes the robot is, as world (x, y): odometry starts at the true start."""
-        return _start_to_world(self.truth.true[0], np.asarray(self.truth.odometry[-1:])[:, 1:3])[0]
+        return start_to_world(_pose_of(self.truth.true[0]), np.asarray(self.truth.odometry[-1:])[:, 1:3])[0]
 
     def true_trajectory(self) -> np.ndarray:
         """The whole true trajectory as world (x, y) rows."""
@@ -213,7 +213,7 @@ class Simulation:
 
     def odometry_trajectory_in_world(self) -> np.ndarray:
         """The whole odometry trajectory as world (x, y) rows."""
-        return _start_to_world(self.truth.true[0], np.asarray(self.truth.odometry)[:, 1:3])
+        return start_to_world(_pose_of(self.truth.true[0]), np.asarray(self.truth.odometry)[:, 1:3])
 
     def ground_truth_report(
         self,
@@ -237,7 +237,7 @@ class Simulation:
         true = np.asarray(self.truth.true, dtype=float)
         xy = true[:, 1:3]
         if frame == "start":  # express the trajectory in the start frame instead
-            xy = _world_to_start(true[0], xy)
+            xy = world_to_start(_pose_of(true[0]), xy)
         report: dict = {
             "world": self.name,
             "seed": self.seed,
@@ -316,19 +316,25 @@ def path_distances(trajectory_xy: np.ndarray, reference_xy: np.ndarray) -> np.nd
     return np.linalg.norm(p - closest, axis=2).min(axis=1)
 
 
-def _start_to_world(start: Sequence[float], xy: np.ndarray) -> np.ndarray:
-    """(x, y) rows given in the frame of the start row (t, x, y, theta), in the world frame."""
-    _, x0, y0, th0 = start
-    c, s = math.cos(th0), math.sin(th0)
-    return np.column_stack([x0 + c * xy[:, 0] - s * xy[:, 1], y0 + s * xy[:, 0] + c * xy[:, 1]])
+def start_to_world(start: Pose2D, xy: np.ndarray) -> np.ndarray:
+    """(x, y) rows (N x 2) given in the frame of the ``start`` pose (origin there, x ahead, y left:
+    the frame odometry counts in from a run's start), in the world frame."""
+    c, s = math.cos(start.theta), math.sin(start.theta)
+    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    return np.column_stack([start.x + c * xy[:, 0] - s * xy[:, 1], start.y + s * xy[:, 0] + c * xy[:, 1]])
 
 
-def _world_to_start(start: Sequence[float], xy: np.ndarray) -> np.ndarray:
-    """The inverse of :func:`_start_to_world`."""
-    _, x0, y0, th0 = start
-    c, s = math.cos(th0), math.sin(th0)
-    rel = xy - (x0, y0)
+def world_to_start(start: Pose2D, xy: np.ndarray) -> np.ndarray:
+    """The inverse of :func:`start_to_world`: world (x, y) rows in the frame of the ``start`` pose."""
+    c, s = math.cos(start.theta), math.sin(start.theta)
+    rel = np.asarray(xy, dtype=np.float64).reshape(-1, 2) - (start.x, start.y)
     return np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])
+
+
+def _pose_of(row: Sequence[float]) -> Pose2D:
+    """The pose of a trajectory row (t, x, y, theta)."""
+    _, x, y, theta = row
+    return Pose2D(float(x), float(y), float(theta))
 
 
 def _stops(rows: np.ndarray, *, tolerance: float = 1e-6) -> list[list[float]]:

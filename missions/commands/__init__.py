@@ -1,7 +1,12 @@
 """One module per ``bearings`` sub-command; each exposes ``register(subparsers)``.
 
 A command module sets ``func`` on its parser: ``func(args) -> int`` returns the exit code.
-Add a module here and list it in :data:`COMMANDS` to add a sub-command.
+Add a module here and list it in :data:`COMMANDS` to add a built-in sub-command. Commands from
+outside ``missions`` (``experiments``: sweep, eval, bench; a plugin package) are entry points of
+the group :data:`ENTRY_POINT_GROUP` naming such a module, declared in their ``pyproject.toml``::
+
+    [project.entry-points."bearings.commands"]
+    sweep = "experiments.commands.sweep"
 """
 
 COMMANDS = (
@@ -10,11 +15,10 @@ COMMANDS = (
     "missions.commands.show",
     "missions.commands.import_",
     "missions.commands.schema",
-    "missions.commands.bench",
     "missions.commands.sim",
     "missions.commands.calibrate",
     "missions.commands.doctor",
     "missions.commands.map",
-    "missions.commands.sweep",
-    "missions.commands.eval",
 )
+
+ENTRY_POINT_GROUP = "bearings.commands"

@@ -18,9 +18,10 @@ from maps.store import InputError
 from missions.commands.common import EXIT_FAILURE, EXIT_OK, fail, print_input_error
 
 DESCRIPTION = """Check a robot before a mission: open each device of the profile (base, pan-tilt unit,
-cameras), print what it reports (robot name/class/subclass, battery, bumpers and stall, pan-tilt
-limits in degrees and its position, each camera's frame size and rate), and close everything again.
-Nothing is commanded to move."""
+cameras), print what it reports (robot name/class/subclass, the model and conversion factors in use
+and where they came from, the link speed, battery, bumpers and stall, pan-tilt limits in degrees
+and its position, each camera's frame size and rate), and close everything again. Nothing is
+commanded to move."""
 
 EPILOG = """example:
   bearings doctor --robot drivers/profiles/p3at-ptu-pinhole.yaml
@@ -82,11 +83,15 @@ def _report_base(base: Any) -> list[str]:
     identity = getattr(base, "identity", None)
     warnings: list[str] = []
     if identity is not None:
-        model = getattr(getattr(base, "params", None), "name", "?")
-        print(f"  identity: name {identity.name!r}, class {identity.robot_class!r}, subclass "
-              f"{identity.subclass!r} (units of model {model})")
-    if getattr(base, "model_warning", None):
-        warnings.append(base.model_warning)
+        print(f"  identity: name {identity.name!r}, class {identity.robot_class!r}, subclass {identity.subclass!r}")
+    model = getattr(base, "model", None)
+    if model is not None:
+        params = model.params
+        print(f"  model: {params.name}, from {model.origin}; {params.dist_conv:g} mm per position unit, "
+              f"{params.angle_conv:g} rad per heading unit, velocity x{params.vel_conv:g}, "
+              f"sonar x{params.range_conv:g}, DiffConvFactor {params.diff_conv:g}")
+        if model.warning:
+            warnings.append(model.warning)
     pose = base.odometry()
     print(f"  odometry: x {pose.x:.3f} m, y {pose.y:.3f} m, heading {math.degrees(pose.theta):.1f} deg")
     status = getattr(base, "status", None)

@@ -11,6 +11,7 @@ from py_trees.common import Status
 from behaviours.roadmap import calibration
 from behaviours.roadmap.calibration import CalibrateTurns, CorrectOdometry
 from behaviours.roadmap.vision import Comparison
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from perception.geometry import Pose2D
 from perception.planar import PlanarResult, PlanarStatus
@@ -23,7 +24,8 @@ def test_a_full_turn_measures_the_turn_scale(gain):
     harness = BehaviourHarness(CalibrateTurns(), blackboard=world.blackboard())
     assert harness.tick_until(between=world.step, max_ticks=1000) == Status.SUCCESS
     assert harness.read("/robot/turn_scale") == pytest.approx(gain, abs=0.002)
-    assert harness.behaviour.report_sections()["roadmap"]["turn_scale"] == pytest.approx(gain, abs=0.002)
+    scale = harness.read("/robot/turn_scale")
+    assert report_sections(harness.behaviour) == {"roadmap": {"turn_scale": round(scale, 5)}}
 
 
 def test_when_the_images_never_match_it_tries_four_headings_then_gives_up(monkeypatch):
@@ -34,6 +36,7 @@ def test_when_the_images_never_match_it_tries_four_headings_then_gives_up(monkey
     assert harness.tick_until(between=world.step, max_ticks=5000) == Status.FAILURE
     assert harness.behaviour.feedback_message.endswith("a full turn never matched (0 inliers at best)")
     assert harness.read("/robot/turn_scale") is None
+    assert report_sections(harness.behaviour) == {}  # no scale measured: nothing to report
     turned = world.true_pose().theta - 0.2
     assert math.degrees(math.remainder(turned, 2 * math.pi)) == pytest.approx(-90.0, abs=5.0)  # 4 x 360 + 3 x 90
 
@@ -58,3 +61,12 @@ def test_corrected_odometry_scales_turns_and_keeps_distances():
     assert (pose.x, pose.y) == pytest.approx((1.0 + math.cos(heading), 2.0 + math.sin(heading)))
     assert pose.stamp == pytest.approx(2.0)
     assert np.isfinite([pose.x, pose.y]).all()
+
+
+def test_an_unset_or_zero_turn_scale_counts_as_one():
+    harness = BehaviourHarness(CorrectOdometry(), blackboard={"/robot/odometry": Pose2D()})
+    harness.tick()
+    harness.write("/robot/turn_scale", 0.0)
+    harness.write("/robot/odometry", Pose2D(0.0, 0.0, 0.3, 0.1))
+    harness.tick()
+    assert harness.read("/robot/calibrated_odometry").theta == pytest.approx(0.3)

@@ -10,6 +10,7 @@ from py_trees.common import Status
 
 from behaviours.roadmap.coverage import CoverageScoring
 from behaviours.roadmap.values import ScanRecord
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from maps.coverage import choose_next, coverage_grid, image_headings, reachable_positions
 from maps.room import RoomEstimate
@@ -46,7 +47,7 @@ def test_marks_each_scan_once_with_the_headings_imaged():
     assert np.array_equal(covered, expected)
     harness.tick()  # the same scan again: nothing more
     assert np.array_equal(harness.read("/map/coverage").covered, covered)
-    assert harness.behaviour.report_sections()["roadmap"]["search"]["scans"] == 1
+    assert report_sections(harness.behaviour)["roadmap"]["search"]["scans"] == 1
 
 
 def test_fails_when_nothing_worth_a_visit_is_left():
@@ -75,7 +76,27 @@ def test_a_goal_not_followed_by_a_scan_is_not_chosen_again():
     assert harness.tick() == Status.SUCCESS  # asked again without a scan: the robot did not get there
     second = harness.read("/map/coverage_goal")
     assert second.distance_to(first) > 0.3
-    assert harness.behaviour.report_sections()["roadmap"]["search"]["unreachable"] == 1
+    assert report_sections(harness.behaviour)["roadmap"]["search"]["unreachable"] == 1
     harness.write("/map/scan", ScanRecord(1, second.x, second.y, tuple(image_headings())))
     harness.tick()  # a scan came: the second goal was reached
-    assert harness.behaviour.report_sections()["roadmap"]["search"]["unreachable"] == 1
+    assert report_sections(harness.behaviour)["roadmap"]["search"]["unreachable"] == 1
+
+
+def test_reports_the_search_and_draws_the_grid_each_time_it_changed():
+    harness = scoring()
+    node = harness.behaviour
+    assert report_sections(node) == {} and list(node.drawings()) == []  # nothing chosen yet
+    harness.tick()
+    assert report_sections(node) == {"roadmap": {"search": {"positions_chosen": 1, "scans": 0, "unreachable": 0,
+                                                            "covered_fraction": 0.0}}}
+    (points,) = node.drawings()
+    assert points.entity == "roadmap/coverage" and len(points.positions) == harness.read("/map/coverage").valid.sum()
+    assert list(node.drawings()) == []  # the same grid: not again
+    goal = harness.read("/map/coverage_goal")
+    harness.write("/map/scan", ScanRecord(1, goal.x, goal.y, tuple(image_headings())))
+    harness.tick()
+    grid = harness.read("/map/coverage")
+    search = report_sections(node)["roadmap"]["search"]
+    assert search == {"positions_chosen": 2, "scans": 1, "unreachable": 0,
+                      "covered_fraction": round(grid.fraction_covered, 4)} and search["covered_fraction"] > 0
+    assert [d.entity for d in node.drawings()] == ["roadmap/coverage"]  # a new grid: drawn again

@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
+from behaviours.roadmap.display import roadmap_section
 from behaviours.roadmap.graph import BuildGraph, measured_motion, straight_is_free
 from behaviours.roadmap.values import TargetImages
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from maps.roadmap import Roadmap
 from maps.room import RoomEstimate
@@ -64,8 +66,12 @@ def test_drives_the_pair_there_and_back_and_fuses_the_edge(tmp_path):
     assert min(error_to(world, A)[0], error_to(world, B)[0]) < 0.03  # ends homed at one of them
     saved = Roadmap.load(tmp_path / "lab.roadmap")
     assert saved.names == ("A", "B") and len(saved.edges) == 1
-    section = harness.behaviour.report_sections()["roadmap"]
-    assert section["connected"] and section["pairs_tried"] == 1 and section["dropped"] == []
+    assert report_sections(harness.behaviour) == {"roadmap": {
+        **roadmap_section(graph), "pairs_tried": 1, "dropped": [], "not_straight": [],
+        "saved": str(tmp_path / "lab.roadmap")}}
+    assert [d.entity for d in harness.behaviour.drawings()] == ["roadmap/targets", "roadmap/targets/labels",
+                                                                "roadmap/graph"]
+    assert list(harness.behaviour.drawings()) == []  # the same graph: not again
 
 
 def test_a_failed_pair_returns_to_the_reference_is_dropped_and_the_graph_is_not_connected():
@@ -75,6 +81,6 @@ def test_a_failed_pair_returns_to_the_reference_is_dropped_and_the_graph_is_not_
     assert harness.tick_until(between=world.step, max_ticks=8000) == Status.FAILURE
     assert harness.behaviour.feedback_message == "the graph is not connected: A | B"
     assert error_to(world, REFERENCE)[0] < 0.03  # back at the reference after the failure
-    dropped = harness.behaviour.report_sections()["roadmap"]["dropped"]
+    dropped = report_sections(harness.behaviour)["roadmap"]["dropped"]
     assert [(d["from"], d["to"]) for d in dropped][0] in (("A", "B"), ("B", "A"))
     assert harness.read("/map/roadmap").edges == ()  # the roadmap is written all the same

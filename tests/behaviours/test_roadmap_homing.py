@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.roadmap.homing import Look, TargetHoming, _step_motion, _triangulate
-from behaviours.roadmap.vision import Comparison, camera_pose
+from behaviours.roadmap.homing import HomingSettings, Look, TargetHoming, _step_motion, _triangulate, room_of
+from behaviours.roadmap.travel import ReturnToReference
+from behaviours.roadmap.vision import MIN_INLIERS, Comparison, camera_pose
 from behaviours.testing import BehaviourHarness
+from maps.room import RoomEstimate
 from perception.geometry import Pose2D
 from perception.planar import PlanarResult, PlanarStatus
 from tests.behaviours.fake_world import FakeWorld, error_to, target_images
@@ -108,3 +110,17 @@ def test_fails_at_once_without_a_target_name_or_images():
     harness = BehaviourHarness(TargetHoming(), blackboard=world.blackboard())
     assert harness.tick() == Status.FAILURE
     assert harness.behaviour.feedback_message == "no target to home to"
+
+
+def test_the_settings_are_the_homing_ports():
+    node = TargetHoming(step=0.3, done_distance=0.05, max_rounds=3, min_inliers=30)
+    assert HomingSettings.of(node) == HomingSettings(0.3, 0.05, 3, 30)
+    assert HomingSettings.of(TargetHoming()) == HomingSettings(0.25, 0.08, 5, MIN_INLIERS)
+
+
+def test_the_room_is_read_whether_a_node_has_it_optional_or_required():
+    room = RoomEstimate.from_polygon(np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 2.0], [0.0, 2.0]]))
+    optional, given, required = TargetHoming(), TargetHoming(room="{/map/room}"), ReturnToReference()
+    for node in (optional, given, required):
+        BehaviourHarness(node, blackboard={"/map/room": room})
+        assert room_of(node) is (None if node is optional else room)  # optional and not given: no room

@@ -5,11 +5,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from py_trees.common import Status
 
 from behaviours.roadmap.navigate import NavigateToTarget
 from behaviours.roadmap.values import TargetImages, TargetView
 from behaviours.roadmap.vision import describe
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from maps.roadmap import EdgeMotion, Roadmap
 from perception.geometry import Pose2D
@@ -38,8 +40,12 @@ def test_localises_at_a_target_then_follows_the_edge_and_homes_at_the_goal():
     assert distance < 0.03 and heading < 1.0
     result = harness.read("/map/navigation")
     assert result.reached and result.localised_at == "A" and result.visited == ("A", "B")
-    section = harness.behaviour.report_sections()["roadmap"]["navigation"]
-    assert section["reached"] and section["visited"] == ["A", "B"] and section["random_moves"] == 0
+    assert report_sections(harness.behaviour) == {"roadmap": {"navigation": {
+        "goal": "B", "reached": True, "localised_at": "A", "visited": ["A", "B"], "random_moves": 0, "rescans": 0,
+        "reason": ""}}}
+    assert [d.entity for d in harness.behaviour.drawings()] == ["roadmap/targets", "roadmap/targets/labels",
+                                                                "roadmap/graph"]
+    assert list(harness.behaviour.drawings()) == []  # the same roadmap: not again
 
 
 def test_an_unknown_target_fails_at_once():
@@ -47,6 +53,13 @@ def test_an_unknown_target_fails_at_once():
     harness = navigate(world, target_images(world, {"A": A}), target="door")
     assert harness.tick() == Status.FAILURE
     assert harness.behaviour.feedback_message == "no target named 'door' in the roadmap (it has: A, B)"
+    assert report_sections(harness.behaviour) == {}  # refused before navigating: nothing to report
+
+
+def test_random_distance_takes_shortest_then_longest():
+    assert NavigateToTarget(target="A", random_distance=[0.2, 0.5]).random_distance == (0.2, 0.5)
+    with pytest.raises(ValueError, match=r"random_distance takes \[shortest, longest\], got \[0.5, 0.2\]"):
+        NavigateToTarget(target="A", random_distance=[0.5, 0.2])
 
 
 def test_moves_randomly_while_nothing_matches_then_gives_up():
@@ -58,4 +71,6 @@ def test_moves_randomly_while_nothing_matches_then_gives_up():
     assert harness.behaviour.feedback_message == "no target matched after 2 random moves"
     result = harness.read("/map/navigation")
     assert not result.reached and result.random_moves == 2 and result.reason == harness.behaviour.feedback_message
+    navigation = report_sections(harness.behaviour)["roadmap"]["navigation"]
+    assert navigation["random_moves"] == 2 and navigation["reason"] == result.reason and navigation["visited"] == []
     assert world.true_pose().distance_to(Pose2D(3.3, 2.7)) > 0.3  # it did move

@@ -8,9 +8,13 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
+from behaviours.roadmap.display import room_section
 from behaviours.roadmap.room import RoomEstimationDodecagon
+from behaviours.roadmap.values import TargetView
+from behaviours.roadmap.vision import describe
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
-from maps.room import dodecagon
+from maps.room import RigMount, RoomEstimate, dodecagon
 from perception.geometry import Pose2D
 from tests.behaviours.fake_world import FakeWorld
 
@@ -32,6 +36,7 @@ def estimated():
     status = harness.tick_until(between=between, max_ticks=2000)
     # read now: every test starts with a clean blackboard
     outputs = {key: harness.read(key) for key in ("/map/room", "/map/reference_image", "/robot/command")}
+    outputs.update(report=report_sections(node), drawings=list(node.drawings()), again=list(node.drawings()))
     return status, node, world, corners, outputs
 
 
@@ -70,3 +75,40 @@ def test_fails_when_the_views_do_not_go_all_around(world_file):
     harness = BehaviourHarness(RoomEstimationDodecagon(), blackboard=world.blackboard())
     assert harness.tick_until(between=world.step, max_ticks=2000) == Status.FAILURE
     assert harness.behaviour.feedback_message.startswith("room estimate:")
+
+
+def test_reports_the_room_and_draws_it_once_and_the_robot_every_time(estimated):
+    _, node, _, _, outputs = estimated
+    room, reference = outputs["/map/room"], outputs["/map/reference_image"]
+    assert outputs["report"] == {"roadmap": {"room": room_section(room, node._points, node._features,
+                                                                  reference.stamp)}}
+    assert [d.entity for d in outputs["drawings"]] == [
+        "roadmap/room/free", "roadmap/room/obstacles", "roadmap/room/corners", "roadmap/room/reference",
+        "roadmap/room/reference/labels", "roadmap/robot"]
+    assert [d.entity for d in outputs["again"]] == ["roadmap/robot"]
+
+
+def test_reports_whatever_room_is_on_its_output_and_nothing_before():
+    node = RoomEstimationDodecagon()
+    harness = BehaviourHarness(node)
+    assert report_sections(node) == {} and list(node.drawings()) == []
+    room = RoomEstimate.from_polygon(np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 2.0], [0.0, 2.0]]))
+    harness.write("/map/room", room)  # a re-anchored room is this node's output too: same key
+    node._points, node._features = [100] * 12, [50] * 12
+    nan_stamp = report_sections(node)["roadmap"]["room"]
+    assert math.isnan(nan_stamp.pop("reference_stamp"))  # no reference image: no stamp
+    expected = room_section(room, [100] * 12, [50] * 12, math.nan)
+    expected.pop("reference_stamp")
+    assert nan_stamp == expected
+    image = np.zeros((8, 8), np.uint8)
+    harness.write("/map/reference_image", TargetView("reference", image, describe(image), stamp=12.5))
+    assert report_sections(node)["roadmap"]["room"]["reference_stamp"] == 12.5
+    assert [d.entity for d in node.drawings()] == ["roadmap/room/free", "roadmap/room/reference",
+                                                   "roadmap/room/reference/labels"]  # no odometry: no robot
+
+
+def test_the_rig_is_mounted_as_its_ports_say():
+    node = RoomEstimationDodecagon(rig_height=1.2, pan_axis=[0.2, 0.01], rig_offset=[0.04, -0.06])
+    assert node.mount() == RigMount(1.2, (0.2, 0.01), (0.04, -0.06))
+    with pytest.raises(ValueError, match=r"RoomEstimationDodecagon.pan_axis takes \[x, y\], got \[0.1\]"):
+        RoomEstimationDodecagon(pan_axis=[0.1])

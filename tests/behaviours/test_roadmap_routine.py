@@ -9,7 +9,8 @@ import py_trees
 import pytest
 from py_trees.common import Status
 
-from behaviours.roadmap.routine import Failed, RoutineBehaviour, Step
+from behaviours.ports import OutputPort
+from behaviours.roadmap.routine import CAMERA_OFFSET, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP, PanTiltState
 from perception.camera import PinholeCamera
@@ -118,3 +119,38 @@ def test_the_head_is_levelled_before_an_image_and_not_commanded_without_one():
 def test_camera_offset_takes_two_numbers():
     with pytest.raises(ValueError, match="camera_offset takes"):
         Errand(camera_offset=[0.1, 0.0, 0.2])
+
+
+def test_motion_uses_the_routines_own_ports_as_bound():
+    node = Errand(turn_speed=90.0, odometry="{/robot/calibrated_odometry}", command="/robot/routine_command")
+    harness = BehaviourHarness(node, blackboard={"/robot/calibrated_odometry": Pose2D()})
+    assert harness.tick() == Status.RUNNING
+    assert (harness.read("/robot/command") or STOP).w == 0.0  # the motion node writes the routine's command key
+    assert harness.read("/robot/routine_command").w == pytest.approx(math.radians(90.0))  # turn_speed, at top rate
+
+
+class Marker(RoutineBehaviour):
+    """Writes one output on its second tick (a test routine, not registered)."""
+
+    MARK = OutputPort("mark", float, "/map/mark", doc="a mark")
+    PORTS = (*ROUTINE_PORTS, MARK)
+
+    def routine(self) -> Step[None]:
+        yield
+        self.set_output(self.MARK, 1.5)
+
+
+@pytest.mark.parametrize("key", ["/map/mark", "/map/elsewhere"])
+def test_written_is_what_the_node_last_wrote_on_its_output_and_none_before(key):
+    node = Marker(mark=key)
+    harness = BehaviourHarness(node)
+    assert harness.tick() == Status.RUNNING and node.written(Marker.MARK) is None
+    assert harness.tick() == Status.SUCCESS and node.written(Marker.MARK) == 1.5
+    assert harness.read(key) == 1.5
+    harness.write(key, 2.5)  # another node wrote the same key since: that is what is there
+    assert node.written(Marker.MARK) == 2.5
+
+
+def test_pair_reads_a_position_port():
+    node = Errand(camera_offset=[0.2, -0.05])
+    assert node.camera_offset == (0.2, -0.05) and node.pair(CAMERA_OFFSET) == (0.2, -0.05)

@@ -65,3 +65,11 @@ def test_targets_already_found_are_not_looked_for():
     harness = scanner(world, target_images(world, {"centre": TARGET}), __map__roadmap=found)
     assert harness.tick() == Status.FAILURE
     assert harness.behaviour.feedback_message == "every target is found already"
+
+
+def test_a_target_sighted_from_here_last_and_not_found_since_is_skipped_from_here_only():
+    node = ScanForTargets()
+    node.last = ("door", Pose2D(1.0, 1.0))  # homing to the door from (1, 1) failed
+    assert node._failed_here("door", Pose2D(1.2, 1.0))  # within 0.3 m: look for the others
+    assert not node._failed_here("door", Pose2D(1.4, 1.0))  # from elsewhere: the door again
+    assert not node._failed_here("window", Pose2D(1.0, 1.0))

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
+from behaviours.roadmap.display import roadmap_section
 from behaviours.roadmap.targets import (
     AllTargetsFound,
     LoadRoadmap,
@@ -18,6 +19,7 @@ from behaviours.roadmap.targets import (
 )
 from behaviours.roadmap.values import HomingResult, TargetImages, TargetView
 from behaviours.roadmap.vision import describe
+from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from maps.roadmap import EdgeMotion, Roadmap
 from maps.room import RoomEstimate
@@ -117,7 +119,18 @@ def test_records_the_homed_target_relative_to_the_reference():
     harness.write("/map/homing", HomingResult("window", Pose2D(1.0, 2.0, math.pi / 2), 0.0, 2, 80, 20.0))
     assert harness.tick() == Status.SUCCESS
     assert harness.read("/map/roadmap").names == ("door", "window")  # added to what was there
-    assert harness.behaviour.report_sections()["roadmap"]["targets"]["window"]["x"] == pytest.approx(0.0)
+    assert report_sections(harness.behaviour)["roadmap"]["targets"]["window"]["x"] == pytest.approx(0.0)
+
+
+def test_record_reports_and_draws_the_roadmap_on_the_blackboard_once_per_roadmap():
+    harness = BehaviourHarness(RecordTarget())
+    assert report_sections(harness.behaviour) == {} and list(harness.behaviour.drawings()) == []  # none yet
+    roadmap = roadmap_with({"door": "door.png", "window": ""})
+    harness.write("/map/roadmap", roadmap)
+    assert report_sections(harness.behaviour) == {"roadmap": roadmap_section(roadmap)}
+    drawn = [d.entity for d in harness.behaviour.drawings()]
+    assert drawn == ["roadmap/targets", "roadmap/targets/labels", "roadmap/graph"]
+    assert list(harness.behaviour.drawings()) == []  # the same roadmap: not again
 
 
 def test_record_fails_without_a_homing_result():

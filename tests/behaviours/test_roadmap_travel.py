@@ -8,10 +8,13 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.roadmap.paths import nearest_standable, reanchored
-from behaviours.roadmap.travel import GoToPose, ReturnToReference
+from behaviours.roadmap import travel as travel_module
+from behaviours.roadmap.homing import HomingSettings
+from behaviours.roadmap.routine import Failed
+from behaviours.roadmap.travel import GoToPose, ReturnToReference, return_to_reference
 from behaviours.roadmap.values import TargetView
 from behaviours.roadmap.vision import describe
+from behaviours.telemetry import Lines, report_sections
 from behaviours.testing import BehaviourHarness
 from maps.room import RoomEstimate
 from perception.geometry import Pose2D
@@ -38,6 +41,10 @@ def test_goes_round_the_wall_to_a_pose_in_the_reference_frame():
     assert plan.ok and len(plan.waypoints) > 2  # not straight: the wall is in the way
     here = room.to_reference(harness.read("/robot/odometry"))
     assert here.distance_to(Pose2D(3.3, 2.5)) < 0.03 and here.theta == pytest.approx(-math.pi / 2, abs=0.02)
+    (path,) = harness.behaviour.drawings()  # the plan, drawn once
+    assert isinstance(path, Lines) and path.entity == "roadmap/plan"
+    assert path.strips[0].tolist() == [[w.x, w.y] for w in plan.waypoints]
+    assert list(harness.behaviour.drawings()) == []
 
 
 def test_no_path_fails_with_the_planners_reason():
@@ -47,22 +54,6 @@ def test_no_path_fails_with_the_planners_reason():
                                            "/mission/goal": Pose2D(8.0, 8.0)})
     assert harness.tick_until(between=integrate) == Status.FAILURE
     assert "no path: the goal is more than" in harness.behaviour.feedback_message
-
-
-def test_nearest_standable_snaps_within_reach_only():
-    free = u_room(Pose2D()).free
-    assert nearest_standable(free, 0.7, 2.5, 0.28) == (0.7, 2.5)
-    snapped = nearest_standable(free, 0.05, 2.5, 0.28)
-    assert snapped is not None and free.can_stand(np.array([snapped]), 0.28)[0]
-    assert nearest_standable(free, 2.0, 2.5, 0.28, snap=0.2) is None  # inside the wall, too far from floor
-
-
-def test_reanchoring_moves_the_reference_only():
-    room = u_room(Pose2D())
-    free = room.free
-    moved = reanchored(room, Pose2D(0.3, 0.1, 0.2))
-    assert moved.free is free and moved.reference_pose == Pose2D(0.3, 0.1, 0.2)
-    assert np.array_equal(moved.polygon, room.polygon)
 
 
 def test_returns_to_the_reference_homes_there_and_reanchors_the_room():
@@ -83,5 +74,51 @@ def test_returns_to_the_reference_homes_there_and_reanchors_the_room():
     anchored = harness.read("/map/room").reference_pose
     assert anchored.distance_to(truth_in_odometry) < 0.03
     assert abs(math.degrees(anchored.theta - truth_in_odometry.theta)) < 1.0
-    section = harness.behaviour.report_sections()["roadmap"]
-    assert section["reference_drift_m (ReturnToReference)"][0] == pytest.approx(math.hypot(0.15, 0.1), abs=0.04)
+    section = report_sections(harness.behaviour)["roadmap"]
+    assert list(section) == ["reference_drift_m (ReturnToReference)"]
+    (drift,) = section["reference_drift_m (ReturnToReference)"]
+    assert drift == pytest.approx(math.hypot(0.15, 0.1), abs=0.04) and drift == round(drift, 4)
+
+
+def test_no_return_no_figure_and_each_return_node_reports_under_its_own_name():
+    assert report_sections(ReturnToReference()) == {}
+    node = ReturnToReference(name="return at the end")
+    node.returns, node.corrections = 2, [0.123456, 0.05]
+    assert report_sections(node) == {"roadmap": {"reference_drift_m (return at the end)": [0.1235, 0.05]}}
+
+
+def finish(step):
+    """Run a routine step to its end, as ticks would: its result."""
+    try:
+        while True:
+            next(step)
+    except StopIteration as stop:
+        return stop.value
+
+
+@pytest.mark.parametrize(("retries", "travels"), [(0, 1), (1, 2)])
+def test_returning_to_the_reference_travels_again_only_as_often_as_told(monkeypatch, retries, travels):
+    calls: list[Pose2D] = []
+
+    def travel(host, room, goal, *, turn):
+        calls.append(goal)
+        assert turn
+        if len(calls) == 1:
+            raise Failed("stalled")
+        yield
+
+    def home(host, reference, settings):
+        yield
+        return ("homed", reference.name, settings)
+
+    monkeypatch.setattr(travel_module, "travel", travel)
+    monkeypatch.setattr(travel_module, "home", home)
+    settings = HomingSettings(0.25, 0.08, 5, 25)
+    reference = TargetView("reference", np.zeros((4, 4), np.uint8), describe(np.zeros((4, 4), np.uint8)))
+    step = return_to_reference(None, u_room(Pose2D()), reference, settings, retries=retries)
+    if retries == 0:
+        with pytest.raises(Failed, match="stalled"):
+            finish(step)
+    else:
+        assert finish(step) == ("homed", "reference", settings)
+    assert calls == [Pose2D()] * travels  # always to the reference pose, the origin of the reference frame

@@ -76,7 +76,7 @@ def base(arcos, devices) -> Callable[..., tuple[PioneerBase, ArcosEmulator]]:
 
     def make(settings: dict[str, Any] | None = None, **options: Any) -> tuple[PioneerBase, ArcosEmulator]:
         emulator = arcos(**options)
-        fields = {"port": emulator.port, "model": options.get("model", "p3dx"), **FAST_BASE, **(settings or {})}
+        fields = {"port": emulator.port, **FAST_BASE, **(settings or {})}
         return devices(open_base(**fields)), emulator
 
     return make

@@ -4,8 +4,14 @@ Power-up state as on the unit: verbose feedback, echo on, a banner waiting in th
 each axis towards its target at the commanded speed (positions/s, times ``time_scale``), enforces
 its position and speed limits with ``!`` errors, records every command with its time, and injects
 faults: ``reply_delay`` (slow replies), ``mute`` (no replies at all), ``refuse`` (the next command
-with a given name gets a ``!`` answer), ``inject_line`` (unsolicited text such as ``!P``) and
-``drop_link()``.
+with a given name gets a ``!`` answer), ``inject_line`` (unsolicited text such as ``!P``),
+``inject`` (raw bytes, no line end) and ``drop_link()``.
+
+``home()`` (or the ``R`` command) resets the unit as flir_ptu_driver describes it: it finds its
+limits, writing ``!T``, ``!T``, ``!P``, ``!P`` as it hits them and ``*`` when it is done, with no
+line ends (``!T!T!P!P*`` on one line), then stands at its home position (0, 0). While it homes it
+answers nothing (the commands are recorded with ``ignored=True``): the worst case a driver must
+live with. See docs/protocols.md.
 """
 
 from __future__ import annotations
@@ -24,11 +30,15 @@ from tests.drivers.emulator_thread import EmulatorThread
 BANNER = "PTU-D46 Controller (C) 1988-2010 DPerception, Inc. All Rights Reserved. v2.14.0"
 
 
+HOMING_STEPS = ("!T", "!T", "!P", "!P", "*")
+
+
 @dataclass(frozen=True)
 class Command:
     t: float
     name: str
     value: float | None
+    ignored: bool = False  # arrived while the unit was homing
 
 
 @dataclass
@@ -65,6 +75,8 @@ class PtuEmulator(EmulatorThread):
         self.limits_enabled = True
         self.mute = False
         self.commands: list[Command] = []
+        self.homings = 0
+        self._homing: list[tuple[float, str]] = []  # (when, what) still to be written by a reset
         self.refusals: dict[tuple[str, bool], str] = {}
         self.crashed: BaseException | None = None
         self._text = ""
@@ -97,6 +109,25 @@ class PtuEmulator(EmulatorThread):
         with self._lock:
             self._write(f"{text}\r\n".encode())
 
+    def inject(self, text: str) -> None:
+        """Write ``text`` as is (no line end)."""
+        with self._lock:
+            self._write(text.encode())
+
+    def home(self, duration: float = 0.3) -> None:
+        """Reset the unit: ``!T!T!P!P*`` spread over ``duration`` seconds, silent meanwhile."""
+        with self._lock:
+            self._start_homing(time.monotonic(), duration)
+
+    @property
+    def homing(self) -> bool:
+        return bool(self._homing)
+
+    def _start_homing(self, now: float, duration: float) -> None:
+        step = duration / len(HOMING_STEPS)
+        self._homing = [(now + step * (i + 1), text) for i, text in enumerate(HOMING_STEPS)]
+        self._outbox.clear()  # a reset drops what was about to be said
+
     def refuse(self, name: str, message: str = "Illegal argument", *, query: bool = False) -> None:
         """Answer ``! message`` to the next ``name`` command that sets a value (or, with ``query``,
         to the next query)."""
@@ -124,6 +155,7 @@ class PtuEmulator(EmulatorThread):
                     self._last_step = now
                     for axis in self.axes.values():
                         axis.step(dt)
+                    self._run_homing(now)
                     due = [p for t, p in self._outbox if t <= now]
                     self._outbox = [(t, p) for t, p in self._outbox if t > now]
                     for packet in due:
@@ -131,6 +163,16 @@ class PtuEmulator(EmulatorThread):
         except BaseException as exc:
             self.crashed = exc
             raise
+
+    def _run_homing(self, now: float) -> None:
+        while self._homing and self._homing[0][0] <= now:
+            _, text = self._homing.pop(0)
+            self._write(text.encode())
+            if not self._homing:  # done: at home, default speed
+                self.homings += 1
+                for axis in self.axes.values():
+                    axis.position = axis.target = 0.0
+                    axis.speed = 1000
 
     def _receive(self, text: str, now: float) -> None:
         if self.echo:
@@ -141,7 +183,12 @@ class PtuEmulator(EmulatorThread):
             return
         complete, self._text = self._text[: cut + 1], self._text[cut + 1 :]
         for name, value in codec.split_commands(complete):
-            self.commands.append(Command(now, name, value))
+            self.commands.append(Command(now, name, value, ignored=self.homing))
+            if self.homing:
+                continue
+            if name == "R" and value is None:
+                self._start_homing(now, 0.3)  # its "*" at the end is the answer
+                continue
             reply = self._execute(name, value)
             if not self.mute:
                 self._outbox.append((now + self.reply_delay, f"{reply}\r\n".encode()))

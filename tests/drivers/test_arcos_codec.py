@@ -1,5 +1,6 @@
-"""The ARCOS codec: the example bytes of PROTOCOLS.md, SIP/config/sync decoding, resynchronisation,
-wrap-around, units per model, and round-trip properties."""
+"""The ARCOS codec: example packets worked out by hand from the framing rules of docs/protocols.md,
+SIP/config/sync decoding, resynchronisation, packets up to 255 bytes, wrap-around, units per
+model, the measured velocity, and round-trip properties."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from hypothesis import strategies as st
 from drivers import arcos
 from drivers.arcos import Command, Identity, Odometry, PacketReader, Sip
 
-EXAMPLES = {  # PROTOCOLS.md, "Examples (hex)"
+EXAMPLES = {  # docs/protocols.md, "ARCOS framing": header, count, payload, checksum
     "SYNC0": ((Command.PULSE, None), "FA FB 03 00 00 00"),
     "ENABLE 1": ((Command.ENABLE, 1), "FA FB 06 04 3B 01 00 05 3B"),
     "VEL 200": ((Command.VEL, 200), "FA FB 06 0B 3B C8 00 D3 3B"),
@@ -69,7 +70,7 @@ def test_a_long_packet_keeps_an_unsigned_count():
 
 
 def _sip_bytes() -> bytes:
-    """A SIP built byte by byte from the offsets in PROTOCOLS.md (not with the codec)."""
+    """A SIP built byte by byte from the offsets in docs/protocols.md (not with the codec)."""
     body = bytes([0x33])
     body += struct.pack("<H", 0x7FF0) + struct.pack("<H", 100)  # XPOS, YPOS
     body += struct.pack("<h", 1024)  # THPOS: a quarter turn
@@ -120,23 +121,48 @@ def test_sync_echoes_and_identity():
 
 def test_config_packet_decodes_while_bytes_remain():
     values = {"robot_type": "Pioneer", "subtype": "p3at", "serial": "AT123", "rot_vel_top": 300,
-              "trans_vel_top": 1200, "name": "Rover", "watchdog": 2000, "trans_ki": 7}
+              "trans_vel_top": 1200, "name": "Rover", "watchdog": 2000, "trans_ki": 7, "reset_baud": 2,
+              "drift_factor": -12, "ticks_mm": 128, "firmware": "1.9"}
     config = arcos.decode_config(arcos.encode_config(values, rest=b"\x09\x09"))
     assert {k: config.get(k) for k in values} == values
     assert config.rest == b"\x09\x09" and config.missing == ()
+    assert config.allows_hostbaud
     short = arcos.decode_config(arcos.encode_config(values)[:30])
-    assert short.get("robot_type") == "Pioneer" and "watchdog" in short.missing
+    assert short.get("robot_type") == "Pioneer" and "watchdog" in short.missing and not short.allows_hostbaud
 
 
 def test_reader_resynchronises_on_garbage_and_corrupt_packets():
     good = [arcos.encode_command(Command.VEL, 100), arcos.encode_command(Command.RVEL, -5)]
     corrupt = bytearray(arcos.encode_command(Command.VEL, 300))
     corrupt[4] ^= 0xFF
-    stream = b"\x00\x17\xfa" + good[0] + b"\xfa\xfb\xff\x01" + bytes(corrupt) + b"\xfa\xfb" + good[1]
+    stream = b"\x00\x17\xfa" + good[0] + b"\xfa\xfb\x01\x01" + bytes(corrupt) + b"\xfa\xfb" + good[1]
     reader = PacketReader()
     out = [p for byte in stream for p in reader.feed(bytes([byte]))]  # one byte at a time: torn everywhere
     assert out == [g[3:-2] for g in good]
     assert reader.stats.bad_checksums >= 1 and reader.stats.bad_lengths >= 1 and reader.stats.skipped_bytes > 0
+
+
+def test_a_255_byte_packet_round_trips_torn_anywhere():
+    payload = bytes([arcos.CONFIG_PACKET]) + bytes((7 * i) % 250 for i in range(252))  # N = 255, no FA in it
+    packet = arcos.frame(payload)
+    assert len(packet) == 258 and packet[2] == 255 == arcos.MAX_COUNT
+    reader = PacketReader()
+    out = [p for byte in packet for p in reader.feed(bytes([byte]))]
+    assert out == [payload] and reader.stats.skipped_bytes == 0
+    with pytest.raises(arcos.PacketError):
+        arcos.frame(payload + b"\x00")  # 256 does not fit the count byte
+    command = arcos.encode_command(Command.SAY, "x" * 249)  # the longest string argument
+    assert len(command) == 258 and arcos.decode_command(arcos.unframe(command)) == (Command.SAY, b"x" * 249)
+
+
+def test_a_corrupt_count_does_not_hold_back_the_packets_behind_it():
+    """Any count up to 255 is legal, so a corrupt one would wait for 255 bytes; a complete packet with a
+    good checksum that starts inside it is taken at once instead."""
+    good = [arcos.encode_command(Command.VEL, 100), arcos.encode_command(Command.RVEL, -5)]
+    reader = PacketReader()
+    assert reader.feed(b"\xfa\xfb\xf0\x01" + good[0]) == [good[0][3:-2]]
+    assert reader.feed(good[1]) == [good[1][3:-2]]
+    assert reader.stats.bad_lengths == 1 and reader.stats.skipped_bytes == 4
 
 
 def test_a_packet_that_starts_inside_a_bogus_one_is_found():
@@ -176,6 +202,16 @@ def test_odometry_starts_at_zero_in_the_first_sips_frame_and_survives_restarts()
     assert (x, y, theta) == pytest.approx((150.0, 0.0, 0.0), abs=0.2)
 
 
+def test_measured_velocity_prefers_the_robots_rotvel():
+    params = arcos.MODELS["p3at"]  # DiffConvFactor 0.0034
+    wheels = Sip(left_vel=100, right_vel=300)  # old firmware: no ROTVEL
+    v, w = arcos.measured_velocity(wheels, params)
+    assert v == 200.0 and w == pytest.approx(math.degrees(100 * 0.0034))  # (300 - 100) / 2 * 0.0034 rad/s = 19.48 deg/s
+    rot_vel = (-125).to_bytes(2, "little", signed=True)
+    reported = Sip(left_vel=100, right_vel=300, extra=(126).to_bytes(2, "little") + b"\x00" + rot_vel)
+    assert arcos.measured_velocity(reported, params) == (200.0, -12.5)  # ROTVEL -125 tenths of a deg/s
+
+
 def test_model_lookup_by_subclass():
     assert arcos.model_for("P3DX-SH").name == "p3dx-sh"
     assert arcos.model_for("p3at").dist_conv == 0.465
@@ -190,7 +226,7 @@ arguments = st.one_of(st.none(), st.integers(-0xFFFF, 0xFFFF), st.binary(max_siz
 @settings(max_examples=100, deadline=None)
 def test_command_round_trip(command, arg):
     packet = arcos.encode_command(command, arg)
-    assert len(packet) < 200
+    assert len(packet) <= 3 + arcos.MAX_COUNT
     assert arcos.decode_command(arcos.unframe(packet)) == (command, arg)
 
 

@@ -136,16 +136,21 @@ def test_open_errors(tmp_path):
 
 # -- HTTP snapshots ------------------------------------------------------------------------------------
 class _Snapshots(BaseHTTPRequestHandler):
-    plan: list[str] = []  # what to answer, one item per request: "jpeg", "500", "junk", "slow"
+    plan: list[str] = []  # what to answer, one item per request: "jpeg", "500", "junk", "held"
     seen_auth: list[str | None] = []
     counter = 0
+    requests = 0
+    holding = threading.Event()  # set while a "held" request waits for `release`
+    release = threading.Event()
 
     def do_GET(self) -> None:  # noqa: N802 - the http.server API
         cls = type(self)
+        cls.requests += 1
         cls.seen_auth.append(self.headers.get("Authorization"))
         mode = cls.plan.pop(0) if cls.plan else "jpeg"
-        if mode == "slow":
-            time.sleep(0.3)
+        if mode == "held":  # a camera that does not answer until the test lets it
+            cls.holding.set()
+            cls.release.wait(10.0)
             mode = "jpeg"
         if mode == "500":
             self.send_error(500, "sensor busy")
@@ -168,12 +173,15 @@ class _Snapshots(BaseHTTPRequestHandler):
 
 @pytest.fixture
 def http_camera_server():
-    _Snapshots.plan, _Snapshots.seen_auth, _Snapshots.counter = [], [], 0
+    _Snapshots.plan, _Snapshots.seen_auth, _Snapshots.counter, _Snapshots.requests = [], [], 0, 0
+    _Snapshots.holding.clear()
+    _Snapshots.release.clear()
     server = ThreadingHTTPServer(("127.0.0.1", 0), _Snapshots)
     server.daemon_threads = True
     thread = threading.Thread(target=server.serve_forever, kwargs={"poll_interval": 0.02}, daemon=True)
     thread.start()
     yield f"http://127.0.0.1:{server.server_address[1]}/axis-cgi/jpg/image.cgi"
+    _Snapshots.release.set()
     server.shutdown()
     server.server_close()
     thread.join(timeout=2.0)
@@ -196,14 +204,23 @@ def test_http_snapshots_with_errors_counted(http_camera_server, devices):
     assert _Snapshots.seen_auth[0] == "Basic " + base64.b64encode(b"op:pw").decode()
 
 
-def test_http_grab_never_blocks_on_a_slow_camera(http_camera_server, devices):
+def test_http_grab_never_waits_for_the_camera(http_camera_server, devices):
+    """While the grab thread is stuck in a request the camera does not answer, grab() keeps returning
+    (the newest frame once, then None) and never asks the camera itself."""
     camera = devices(open_http_camera(url=http_camera_server, period=0.01))
-    _Snapshots.plan[:] = ["slow"] * 3
-    for _ in range(20):
-        start = time.perf_counter()
-        camera.grab()
-        assert time.perf_counter() - start < 0.005
-        time.sleep(0.01)
+    _Snapshots.plan[:] = ["held"]
+    assert _Snapshots.holding.wait(5.0)  # the grab thread is now inside a request that does not end
+    requests, empty = _Snapshots.requests, camera.stats().empty_grabs
+    results: list[object] = []
+    caller = threading.Thread(target=lambda: results.extend(camera.grab() for _ in range(20)), daemon=True)
+    caller.start()
+    caller.join(10.0)  # only a hang detector: if grab() waited for the camera it would never come back
+    assert not caller.is_alive() and len(results) == 20
+    assert _Snapshots.holding.is_set() and not _Snapshots.release.is_set()  # still stuck all along
+    assert results[1:] == [None] * 19 and camera.stats().empty_grabs >= empty + 19
+    assert _Snapshots.requests == requests  # grab() sent no request of its own
+    _Snapshots.release.set()
+    assert _wait_frame(camera) is not None  # the answer, when it comes, is delivered
 
 
 def test_http_camera_that_never_answers(http_camera_server):

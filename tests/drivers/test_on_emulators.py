@@ -1,5 +1,5 @@
 """End to end through the profile loader: ``bearings doctor`` and ``bearings run --robot`` against the
-emulated Pioneer (TCP like MobileSim, and pty), PTU-D46 (pty) and a video-file camera."""
+emulated Pioneer (TCP as MobileSim, pty as the robot's firmware), PTU-D46 (pty) and a video-file camera."""
 
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ def _video(path: Path) -> Path:
 
 def _profile(tmp_path: Path, base_port: str, ptu_port: str | None = None, video: Path | None = None,
              extra: str = "") -> Path:
-    lines = ["robot: bench", f'base: {{driver: pioneer, port: "{base_port}", model: p3dx, {BASE_TIMING}{extra}}}']
+    lines = ["robot: bench", f'base: {{driver: pioneer, port: "{base_port}", {BASE_TIMING}{extra}}}']
     if ptu_port:
         lines.append(f'ptu: {{driver: ptu_d46, port: "{ptu_port}", {PTU_TIMING}}}')
     if video:
@@ -49,6 +49,9 @@ def test_doctor_reports_every_device(tmp_path, arcos, ptu_emulator, capsys):
     out = capsys.readouterr().out
     assert "robot bench" in out
     assert "name 'lab-dx', class 'Pioneer', subclass 'p3dx'" in out
+    assert "base: pioneer on " in out and " at 38400 bit/s" in out  # the robot allowed HOSTBAUD
+    assert "model: p3dx, from the robot's SYNC2 subclass 'p3dx'; 0.485 mm per position unit" in out
+    assert "DiffConvFactor 0.0056" in out and "warning" not in out
     assert "battery 12.6 V (low at 11.0 V); motors enabled; e-stop released" in out
     assert "pan: now 0.00 deg, limits -158.91 .. 158.91 deg, 0.0514 deg per position" in out
     assert "tilt: now 0.00 deg, limits -46.65 .. 31.06 deg" in out
@@ -56,6 +59,15 @@ def test_doctor_reports_every_device(tmp_path, arcos, ptu_emulator, capsys):
     assert out.rstrip().endswith("OK: every device answered")
     assert base.wait_for(lambda: base.named("CLOSE")) and not base.enabled  # left closed and disabled
     assert not [e for e in base.events if e.name in ("VEL", "RVEL") and e.arg]  # nothing was moved
+
+
+def test_doctor_says_when_a_model_override_is_used(tmp_path, arcos, capsys):
+    base = arcos(model="p3dx-sh")
+    profile = _profile(tmp_path, base.port, extra=", model_override: p3at")
+    assert main(["doctor", "--robot", str(profile), "--seconds", "0.1"]) == 0
+    out = capsys.readouterr().out
+    assert "model: p3at, from model_override in the profile (the robot reports 'p3dx-sh'); 0.465 mm" in out
+    assert "warning: model_override p3at is in use but the robot reports 'p3dx-sh'" in out
 
 
 def test_doctor_fails_with_the_reason(tmp_path, arcos, capsys):
@@ -92,6 +104,44 @@ def test_a_library_mission_runs_on_the_emulated_robot_and_leaves_it_stopped(tmp_
     assert last_vel == [0, 0] and base.named("ENABLE")[-1].arg == 0
     assert ptu.named("H")  # the pan-tilt unit was halted too
     assert base.bad_packets == 0
+    assert base.sessions_ended == 1 and not base.connected  # MobileSim closed the session on CLOSE
+    model = result["base"]
+    assert (model["model"], model["source"], model["reported_subclass"]) == ("p3dx", "robot", "p3dx")
+    assert model["dist_conv_mm"] == 0.485 and model["baud"] is None
+
+
+ONE_METRE = """mission: one_metre
+rate: 50
+max_time: 30
+cameras: []
+tree:
+  Sequence:
+    name: go
+    children:
+      - Drive: {distance: 1.0, speed: 0.25}
+      - Stop
+"""
+
+
+def test_a_p3at_profile_on_a_robot_that_reports_p3dx_sh_drives_true(tmp_path, arcos, capsys):
+    """The case of issue 24: told to drive 1 m with the shipped P3-AT profile on a robot reporting p3dx-sh,
+    the robot used to drive 2.14 m while odometry said 0.99 m. Now odometry is the robot's own."""
+    base = arcos(model="p3dx-sh", sip_period=0.01, time_scale=4.0)
+    shipped = load_yaml(PROFILES / "p3at-ptu-pinhole.yaml")["base"]
+    fields = {**{k: v for k, v in shipped.items() if k != "port"}, **FAST_BASE}
+    profile = tmp_path / "robot.yaml"
+    settings = ", ".join(f"{k}: {v}" for k, v in fields.items())
+    profile.write_text(f"base: {{port: {json.dumps(base.port)}, {settings}}}\n")
+    mission = tmp_path / "one_metre.yaml"
+    mission.write_text(ONE_METRE)
+    report = tmp_path / "report.json"
+    code = main(["run", str(mission), "--robot", str(profile), "--quiet", "--report", str(report)])
+    assert code == 0, capsys.readouterr()
+    result = json.loads(report.read_text())
+    truth = base.pose()[0]
+    assert result["odometry"]["x"] == pytest.approx(truth, rel=0.01)
+    assert truth == pytest.approx(1.0, abs=0.05)
+    assert result["base"]["model"] == "p3dx-sh" and result["base"]["source"] == "robot"
 
 
 def test_a_lost_link_ends_the_mission_in_failure_with_the_reason(tmp_path, arcos, capsys):

@@ -1,4 +1,5 @@
-"""The PTU-D46 driver against the emulated unit (pty), and its codec."""
+"""The PTU-D46 driver against the emulated unit (pty), and its codec (the message grammar of
+docs/protocols.md: a stream of ``*``/``!`` messages, which need not be on lines of their own)."""
 
 from __future__ import annotations
 
@@ -24,29 +25,51 @@ def test_codec_commands_and_replies():
     assert codec.encode("pp", -90) == b"PP-90 "
     assert codec.encode("PR") == b"PR "
     assert codec.split_commands("pp100 TP\r ps  x! ") == [("PP", 100.0), ("TP", None), ("PS", None), ("?x!", None)]
-    assert codec.parse_line("*") == codec.Reply("ok", "*", None)
-    assert codec.parse_line("* 185.1428").value == pytest.approx(185.1428)
-    assert codec.parse_line("* Current Pan position is -583").value == -583
-    assert codec.parse_line("! Illegal argument") == codec.Reply("error", "Illegal argument")
-    assert codec.parse_line("!P").axis == "pan" and codec.parse_line("!T").axis == "tilt"
-    assert codec.parse_line("PTU-D46 Controller v2.14.0").kind == "noise"
+    assert codec.parse_message("*") == codec.Reply("ok", "*", None)
+    assert codec.parse_message("* 185.1428").value == pytest.approx(185.1428)
+    assert codec.parse_message("* Current Pan position is -583").value == -583
+    assert codec.parse_message("! Illegal argument") == codec.Reply("error", "Illegal argument")
+    assert codec.parse_message("!P").axis == "pan" and codec.parse_message("!T").axis == "tilt"
+    assert codec.parse_message("PTU-D46 Controller v2.14.0").kind == "noise"
     assert codec.to_positions(math.radians(0.0514285), RES) == 1
     assert codec.to_radians(3090, RES) == pytest.approx(math.radians(158.914), abs=1e-5)
 
 
-def test_line_reader_handles_torn_lines_and_both_line_ends():
-    reader = codec.LineReader()
-    assert reader.feed(b"* 1") == []
-    assert reader.feed(b"2\r\n!P\r\n\r\n*") == ["* 12", "!P"]
-    assert reader.feed(b"\n") == ["*"]
-    assert reader.feed(b"x" * 300) == [] and reader.dropped == 300
+def _kinds(replies):
+    return [(r.kind, r.text) for r in replies]
 
 
-@given(st.binary(max_size=200))
+def test_messages_are_split_at_their_markers_not_at_line_ends():
+    reader = codec.MessageReader()
+    assert reader.feed(b"PTU-D46 Controller v2.14.0\r\n* 1") == [] and reader.noise == 26  # banner: noise
+    assert _kinds(reader.feed(b"2\r\n!P!P\r\n*\n")) == [("ok", "* 12"), ("limit", "!P"), ("limit", "!P"),
+                                                         ("ok", "*")]  # torn, run together, both line ends
+    assert _kinds(reader.feed(b"*! Illegal argument\r\n")) == [("ok", "*"), ("error", "Illegal argument")]
+    assert _kinds(reader.feed(b"! Pan! too far\r\n")) == [("error", "Pan! too far")]  # "!" inside a text
+    assert _kinds(reader.feed(b"* 1* 2\r\n")) == [("ok", "* 1"), ("ok", "* 2")]  # "*" always starts one
+    reader.feed(b"* " + b"9" * 300)
+    assert reader.feed(b"\r\n") == [] and reader.noise > 300  # an endless message is dropped
+
+
+def test_a_reset_is_read_as_limit_hits_then_homed():
+    """flir_ptu_driver's reset answer, ``!T!T!P!P*`` on one line with no line end after it."""
+    reader = codec.MessageReader()
+    assert _kinds(reader.feed(b"!T!T!P!P*")) == [("limit", "!T"), ("limit", "!T"), ("limit", "!P"), ("limit", "!P")]
+    assert _kinds(reader.idle()) == [("homed", "*")]  # its last byte: complete when nothing more comes
+    assert _kinds(reader.feed(b"!T\r\n")) + _kinds(reader.feed(b"*\r\n")) == [("limit", "!T"), ("ok", "*")]
+    assert reader.idle() == []  # a bare "*" waits for its line end unless limit hits came before it
+    reader.feed(b"!P!T")
+    reader.clear()  # a command is sent in between: the limit hits are kept
+    assert _kinds(reader.feed(b"*\r\n")) == [("homed", "*")]
+
+
+@given(st.lists(st.binary(max_size=40), max_size=8))
 @settings(max_examples=100, deadline=None)
-def test_line_reader_and_parser_never_raise(data):
-    for line in codec.LineReader().feed(data):
-        assert codec.parse_line(line).kind in ("ok", "error", "limit", "noise")
+def test_message_reader_never_raises(chunks):
+    reader = codec.MessageReader()
+    for chunk in chunks:
+        for reply in reader.feed(chunk) + reader.idle():
+            assert reply.kind in ("ok", "error", "limit", "homed")
 
 
 @given(st.floats(-3.0, 3.0))
@@ -143,6 +166,30 @@ def test_unsolicited_lines_are_tolerated(ptu):
     pan_tilt.move(0.1, 0.05, 1.0)
     assert _wait(lambda: not pan_tilt.state().moving)
     assert pan_tilt.fault is None and pan_tilt.errors == 0
+
+
+def test_run_together_limit_hits_are_not_errors(ptu):
+    pan_tilt, emulator = ptu()
+    emulator.inject("!P!T")
+    pan_tilt.move(0.1, 0.0, 1.0)
+    assert _wait(lambda: pan_tilt.limit_hits == 2 and not pan_tilt.state().moving)
+    assert pan_tilt.errors == 0 and pan_tilt.fault is None
+
+
+def test_a_unit_that_resets_and_homes_mid_session_goes_back_to_its_target(ptu):
+    """The unit resets: silent while it finds its limits (``!T!T!P!P``, then ``*``), then at home. The
+    mission must not fail nor hang: no error, no fault, and the last move is sent again."""
+    pan_tilt, emulator = ptu(time_scale=10.0, settings={"max_timeouts": 2})
+    pan_tilt.move(math.radians(30.0), math.radians(-10.0), math.radians(60.0))
+    assert _wait(lambda: not pan_tilt.state().moving)
+    target = pan_tilt.positions()
+    emulator.home(duration=1.0)  # five times the reply timeout, more than max_timeouts replies missed
+    assert _wait(lambda: pan_tilt.homings == 1, timeout=3.0)
+    assert [c for c in emulator.commands if c.ignored]  # it did ask, and was not answered, meanwhile
+    assert _wait(lambda: not pan_tilt.state().moving and pan_tilt.positions() == target, timeout=3.0)
+    assert pan_tilt.state() is not None  # no PtuError was waiting
+    assert pan_tilt.fault is None and pan_tilt.errors == 0 and pan_tilt.limit_hits == 4
+    assert emulator.homings == 1 and emulator.position() == pytest.approx(target, abs=1)  # where it was sent
 
 
 def test_slow_replies_are_waited_for(ptu):

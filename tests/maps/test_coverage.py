@@ -46,6 +46,14 @@ def test_new_coverage_by_hand_3x3():
                                                          [216 - 12, 288 - 12, 216 - 12]])
 
 
+def test_cell_positions_one_by_one_or_as_arrays():
+    grid = CoverageGrid.empty(np.ones((3, 2), bool), 1, cell=0.1, origin=(-0.5, 2.0))
+    assert grid.position(2, 1) == pytest.approx((-0.3, 2.1))
+    x, y = grid.position(*np.indices(grid.valid.shape))  # every cell at once, as the same sums
+    assert x.shape == y.shape == (3, 2)
+    assert all((x[i, j], y[i, j]) == grid.position(i, j) for i in range(3) for j in range(2))
+
+
 def test_invalid_positions_are_neither_covered_nor_candidates():
     valid = np.ones((3, 3), bool)
     valid[1, 1] = False

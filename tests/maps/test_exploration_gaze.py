@@ -7,8 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from maps.exploration import ExplorationMap, GridFrame, Interest, StereoHead
-from maps.exploration_gaze import (
+from maps.exploration.gaze import (
     Gaze,
     GazeParams,
     camera_lift,
@@ -18,6 +17,9 @@ from maps.exploration_gaze import (
     speed_limit,
     survey,
 )
+from maps.exploration.grid import ExplorationMap, GridFrame
+from maps.exploration.head import StereoHead
+from maps.exploration.interest import Interest
 from perception.geometry import Pose2D
 
 HEAD = StereoHead(ptu=(0.1, 0.0, 1.0), camera=(0.05, 0.0, 0.08))  # lens 1.08 m up

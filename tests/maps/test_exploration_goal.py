@@ -7,8 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from maps.exploration import Cell, ExplorationMap, GridFrame, traversable
-from maps.exploration_goal import (
+from maps.exploration.goal import (
     GoalParams,
     Mode,
     ModeSwitch,
@@ -17,6 +16,8 @@ from maps.exploration_goal import (
     select_goal,
     verification_goal,
 )
+from maps.exploration.grid import Cell, ExplorationMap, GridFrame
+from maps.exploration.travel import traversable
 
 NO_RADIUS = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1)
 ROBOT = (0.25, 0.55)  # the centre of cell (row 5, col 2)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from maps.exploration_pose import FilterParams, PoseFilter
+from maps.exploration.pose import FilterParams, PoseFilter
 from perception.geometry import Pose2D, wrap_angle
 
 LANDMARKS = {1: (4.0, 0.0), 2: (0.0, 5.0), 3: (-3.0, -3.0), 4: (3.0, 3.0)}

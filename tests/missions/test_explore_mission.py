@@ -6,8 +6,8 @@ import json
 from pathlib import Path
 
 from drivers.sim.world import load_world
+from experiments.eval.exploration import check_world, episode_figures
 from missions.cli import main
-from missions.eval.exploration import check_world, episode_figures
 
 BOX = str(Path(__file__).resolve().parents[1] / "data" / "worlds" / "box.yaml")
 

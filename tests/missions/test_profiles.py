@@ -23,12 +23,12 @@ def test_shipped_profiles_are_valid_and_need_their_hardware(path, capsys):
 
 def test_driver_settings_errors_are_located_in_the_profile(tmp_path):
     path = tmp_path / "robot.yaml"
-    path.write_text("base: {driver: pioneer, port: /dev/ttyUSB0, model: p4dx}\n"
+    path.write_text("base: {driver: pioneer, port: /dev/ttyUSB0, model_override: p4dx}\n"
                     "cameras:\n  eye: {driver: opencv, device: 0, fps: 1000}\n")
     with pytest.raises(InputError) as info:
         load_profile(path)
     found = [(d.line, d.message) for d in info.value.diagnostics]
-    assert any(line == 1 and m.startswith("base.model must be one of") for line, m in found), found
+    assert any(line == 1 and m.startswith("base.model_override must be one of") for line, m in found), found
     assert any(line == 3 and m.startswith("cameras.eye.fps must be <= 240 Hz") for line, m in found), found
 
 

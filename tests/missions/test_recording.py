@@ -6,6 +6,7 @@ from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
+import py_trees
 
 from behaviours.telemetry import Arrows, Drawing, Event, Figure, Lines, Picture, Plot, Points
 from missions.recording import Recorder
@@ -66,3 +67,16 @@ def test_a_figure_is_plotted_only_when_it_changes():
         recorder.log_node(node)
     plotted = [kwargs["args"][0] for entity, _, kwargs in fake.logged if entity == "figures/ltmap/search/scans"]
     assert plotted == [[0.0], [1.0], [2.0]]
+
+
+def test_figures_are_gathered_at_most_once_a_second_of_the_run():
+    recorder, fake = _recorder()
+    recorder._figures_at, recorder._last_status = float("-inf"), {}
+    recorder.timeline = "sim_time"
+    node = _Node()
+    root = py_trees.behaviours.Success(name="root")
+    for tick in range(25):  # 10 Hz for 2.4 s: figures at 0.0, 1.0 and 2.0 s
+        node.count = tick
+        recorder.log_tick(time_s=tick * 0.1, tick=tick, root=root, odometry=None, command=None, nodes=[node])
+    plotted = [kwargs["args"][0] for entity, _, kwargs in fake.logged if entity == "figures/ltmap/search/scans"]
+    assert plotted == [[0.0], [10.0], [20.0]]

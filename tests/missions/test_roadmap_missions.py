@@ -1,5 +1,5 @@
-"""The roadmap missions end to end in the simulator (short runs; the long measurements are by hand,
-``python -m tests.missions.measure_roadmap``, figures in docs/roadmap.md)."""
+"""The roadmap missions end to end in the simulator (short runs; the long measurements are
+``bearings eval roadmap``'s, figures in docs/roadmap.md)."""
 
 from __future__ import annotations
 
@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from experiments.eval.roadmap_world import named_poses, pose_error, world_with, write_target_images
+from experiments.eval.trajectory import TrueTrajectory
 from maps.roadmap import EdgeMotion, Roadmap
 from missions.cli import main
-from missions.eval.roadmap_world import TrueTrajectory, named_poses, pose_error, world_with, write_target_images
 from perception.geometry import Pose2D
 
 SMALL_ROOM = """

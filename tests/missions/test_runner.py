@@ -225,20 +225,22 @@ REPORTING_PLUGIN = """
 from py_trees.common import Status
 from behaviours.base import BearingsBehaviour
 from behaviours.registry import register
+from behaviours.telemetry import Event, Figure
 
 @register
 class CountTicks(BearingsBehaviour):
-    '''Counts its ticks; reports them and logs them to rerun (a test plugin).'''
+    '''Counts its ticks; reports them as figures and draws an event per tick (a test plugin).'''
     def initialise(self):
         self.ticks, self.logged = 0, 0
     def update(self):
         self.ticks += 1
         return Status.SUCCESS if self.ticks == 5 else Status.RUNNING
-    def report_sections(self):
-        return {"counting": {"ticks": self.ticks, "logged": self.logged}}
-    def log_rerun(self, rec):
+    def figures(self):
+        yield Figure("counting", "ticks", self.ticks)
+        yield Figure("counting", "logged", self.logged)
+    def drawings(self):
         self.logged += 1
-        rec.log("counting/ticks", rec.Scalars([self.ticks]))
+        yield Event("counting/events", f"tick {self.ticks}")
 """
 
 

@@ -176,7 +176,7 @@ def test_at_least_as_accurate_as_poselib_five_point_on_the_same_scenes():
     simulator's 640 x 480 front camera, the same 2 px threshold), the median rotation and
     direction errors of planar homing are no worse than PoseLib's LO-RANSAC 5-point relative
     pose, both measured here on the same fixed scenes."""
-    from missions.bench.perception import planar_comparison
+    from experiments.bench.perception import planar_comparison
 
     rows = planar_comparison(range(50), opencv=False)
     for figure in ("rotation_error_deg", "direction_error_deg"):

@@ -50,6 +50,9 @@ def test_a_room_with_a_box_and_a_pillar_by_hand(world_file):
     rows, cols, _ = floor.cells_of(np.array([[2.5, 1.5], [0.1, 1.5], [2.0, 0.5]]))
     assert floor.reachable[rows, cols].tolist() == [False, False, True]
     assert floor.free[rows, cols].tolist() == [False, True, True]  # box interiors are solid
+    off_grid = [floor.x0 - 1.0, 1.5]
+    assert floor.reachable_at(np.array([[2.5, 1.5], [0.1, 1.5], [2.0, 0.5], off_grid])).tolist() == [
+        False, False, True, False]
 
 
 def test_a_door_narrower_than_the_robot_closes_the_next_room(world_file):

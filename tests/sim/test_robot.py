@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from drivers.interfaces import Base, PanTilt
+from drivers.sim.simulation import start_to_world, world_to_start
 from perception.geometry import Pose2D
 
 ROOM = """
@@ -133,6 +135,14 @@ def test_ground_truth_report_measures_goal_and_path_errors_in_world_or_start_fra
     assert start["goal_error_m"] == pytest.approx(math.hypot(pose.y - 1.0 - 0.7, 1.0 - pose.x), abs=1e-9)
     assert start["path_error_m"] == pytest.approx(world["path_error_m"], abs=1e-9)
     assert start["trajectory_length_m"] == pytest.approx(world["trajectory_length_m"])
+
+
+def test_the_start_frame_is_the_start_pose_turned_and_moved() -> None:
+    """From the start (1, 2) facing +y (90 deg): 1 m ahead is world (1, 3), 1 m left is world (0, 2)."""
+    start = Pose2D(1.0, 2.0, math.pi / 2)
+    world = start_to_world(start, np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]))
+    assert world == pytest.approx(np.array([[1.0, 3.0], [0.0, 2.0], [1.0, 2.0]]), abs=1e-12)
+    assert world_to_start(start, world) == pytest.approx(np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]), abs=1e-12)
 
 
 def test_a_long_step_cannot_jump_over_a_thin_wall(sim_from) -> None:

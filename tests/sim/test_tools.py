@@ -1,8 +1,7 @@
-"""``bearings sim`` commands, ``bearings bench sim`` figures and the rerun log of a run."""
+"""``bearings sim`` commands and the rerun log of a run."""
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -11,7 +10,6 @@ import numpy as np
 import pytest
 
 from drivers.sim.simulation import Simulation
-from missions.bench import sim as bench_sim
 from missions.cli import main
 from perception.geometry import Pose2D
 
@@ -61,16 +59,6 @@ def test_sim_worlds_lists_the_shipped_worlds(capsys) -> None:
     out = capsys.readouterr().out
     for name in ("lab", "corridor", "outdoor", "unbalanced"):
         assert f"{name}:" in out
-
-
-def test_bench_reports_named_json_figures() -> None:
-    figures = bench_sim.run(quick=True)
-    json.dumps(figures)  # serialisable
-    for key in ("panoramas_per_s_lab", "panoramas_per_s_outdoor", "steps_per_s_bearings", "remap_reference_ms"):
-        assert figures[key] > 0
-    assert figures["panorama_cost_ratio_lab"] == pytest.approx(
-        1e3 / figures["panoramas_per_s_lab"] / figures["remap_reference_ms"], rel=0.01
-    )
 
 
 def test_log_rerun_records_world_trajectories_images_and_view_direction(tmp_path: Path) -> None:

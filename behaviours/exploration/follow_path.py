@@ -1,0 +1,346 @@
+"""Following the exploration goal's path through the known free floor, safely.
+
+:class:`FollowPath` drives along the path of the goal on its ``goal`` input (the travel-cost path of
+:mod:`maps.exploration.travel`: 8-connected cells through known free space with clearance) with the
+control of :class:`behaviours.motion.DriveTo`: turn on the spot towards a carrot ``lookahead``
+metres down the path when it is more than ``turn_in_place`` off the heading, else drive while
+steering, speed ramped down near the end within the deceleration limit, capped by ``speed_limit``
+(the gaze's eq. 4).
+
+Collision safety has its own checks, because the cameras see nothing nearer than ~0.66 m (96
+disparities) and may be looking sideways:
+
+- **Path ahead**: the path's next ``check_distance`` metres must keep the robot's disc clear of
+  obstacle cells in the current map; otherwise it is planned again from here
+  (:func:`maps.exploration.travel.travel_cost`), and FAILURE when the target cannot be reached any more.
+- **Motion**: the speed lets the base stop (within its deceleration) before the arc it is driving
+  brings an obstacle cell within ``robot_radius + clearance`` of its centre, nearer than now
+  (:func:`free_travel`). Pure pursuit cuts corners, and a stop commanded at once still coasts a
+  quarter of a metre at 0.4 m/s (0.3 m/s^2): in one simulated run the robot swung round a table's
+  corner on a path planned clear of it and touched it while coasting.
+- **Seen floor ahead only**: the robot does not drive *into* floor it has not seen: it brakes to
+  ``crawl`` ``unseen_margin`` before the first point of the path ahead where the front of its disc
+  (within ``front`` of the direction of travel) covers an unknown cell (beyond the disc it covers
+  now), and stops before its disc covers it. Those cells go to ``unseen_ahead`` (None when the
+  next ``guard`` metres are seen), for the gaze to look at, since the cameras may be watching
+  something else (:class:`behaviours.exploration.gaze.WatchInterestEdges`). The margin is where the cameras can
+  still see that floor (their near edge is ~0.36 m from the lens at the lowest tilt), and the
+  crawl stops within 2 cm when they find an obstacle there (in one simulated run the robot, at
+  full speed with unseen floor 0.6 m ahead round a table's corner, saw the corner, gave the goal
+  up and touched it while coasting). Stopping at the margin instead deadlocks at corners: the
+  floor round a corner is seen only by moving along the path. Unknown floor *beside* the path does
+  not hold the robot: within ~0.5 m of the lens the cameras see nothing, so floor beside a path
+  along a border would never become seen from it (tried: the robot stalled at every border it
+  drove along); a tall obstacle there would have been seen ahead, from farther away, by cameras
+  looking where the robot goes. The goal itself is a border point, next to the unknown: the robot
+  stops about a radius before it unless the cameras see beyond it first.
+- **Progress**: no metre of path gained for ``stuck_time`` seconds (a stop before unseen floor the
+  cameras cannot see from here: nearer than their ~0.5 m blind zone): FAILURE, so that a recovery
+  looks around and the goal is chosen again.
+- **Stall** (a collision after all): back away for ``backoff`` seconds, then go on; FAILURE after
+  ``max_stalls`` stalls on one goal.
+
+It never succeeds: it follows whatever goal is on the blackboard, stopping on arrival until the
+next one (run it beside :class:`behaviours.exploration.select_goal.SelectGoalPoint` in a parallel whose
+success is the selection's). FAILURE (unreachable, stalls) lets a recovery run and the selection
+choose again.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+
+from behaviours.base import BearingsBehaviour
+from behaviours.exploration.ports import CLEARANCE, GOAL, MAP, POSE, ROBOT_RADIUS
+from behaviours.motion import ANGULAR_DECEL, COMMAND, LINEAR_DECEL, STALLED, ramp
+from behaviours.ports import InputPort, OutputPort
+from behaviours.registry import register
+from behaviours.telemetry import Drawing, Figure, Lines
+from drivers.interfaces import STOP, VelocityCommand
+from maps.exploration.goal import Goal
+from maps.exploration.grid import Cell, ExplorationMap
+from maps.exploration.travel import travel_cost
+from perception.geometry import Pose2D, wrap_angle
+
+
+def _disc_offsets(m: ExplorationMap, radius: float) -> np.ndarray:
+    """(row, column) offsets (K x 2) of the cells of a disc of ``radius`` around a cell."""
+    f = m.frame
+    k = int(math.ceil(radius / f.resolution))
+    offsets = np.mgrid[-k : k + 1, -k : k + 1].reshape(2, -1).T
+    return offsets[np.hypot(*(offsets * f.resolution).T) <= radius + f.resolution * 0.5]
+
+
+def cells_around(
+    m: ExplorationMap, centres: np.ndarray, radius: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The cells around each of ``centres`` (N x 2) out to a superset of the disc of ``radius``, centre
+    after centre: their centres (K x 2), their offsets from their disc's centre (K x 2), the length
+    of those (K,), and their states (uint8 Cell, UNKNOWN outside the grid). The disc itself is
+    ``distance <= radius``."""
+    f = m.frame
+    points = np.asarray(centres, dtype=np.float64).reshape(-1, 2)
+    offsets = _disc_offsets(m, radius + f.resolution)  # a superset: a disc around a point, not a cell centre
+    rows, cols = f.cell_of(points)
+    r = (rows[:, None] + offsets[None, :, 0]).ravel()
+    c = (cols[:, None] + offsets[None, :, 1]).ravel()
+    xy = f.centre_of(r, c)
+    rel = xy - np.repeat(points, len(offsets), axis=0)
+    inside = f.inside(r, c)
+    states = np.full(len(r), Cell.UNKNOWN, dtype=np.uint8)
+    states[inside] = m.cells[r[inside], c[inside]]
+    return xy, rel, np.hypot(*rel.T), states
+
+
+def disc_cells(m: ExplorationMap, centres: np.ndarray, radius: float) -> np.ndarray:
+    """The states (uint8 Cell) of the cells whose centres lie within ``radius`` of any of ``centres``
+    (exactly: a travel-cost path, whose cells have more clearance than the radius, is never found
+    blocked by this)."""
+    _, _, distance, states = cells_around(m, centres, radius)
+    return states[distance <= radius]
+
+
+def free_travel(m: ExplorationMap, pose: Pose2D, curvature: float, room: float, reach: float) -> float:
+    """How far (m, at most ``reach``) the robot can go along the arc of ``curvature`` (1/m, left
+    positive) from ``pose`` before an obstacle cell comes within ``room`` of its centre, nearer than
+    now by a quarter cell (a robot already closer to something may still move along or away from it)."""
+    f = m.frame
+    k = int(math.ceil((reach + room) / f.resolution)) + 1
+    rows, cols = f.cell_of(np.array([[pose.x, pose.y]]))
+    r0, c0 = int(rows[0]), int(cols[0])
+    window = (slice(max(r0 - k, 0), max(r0 + k + 1, 0)), slice(max(c0 - k, 0), max(c0 + k + 1, 0)))
+    wr, wc = np.nonzero(m.cells[window] == Cell.OBSTACLE)
+    if len(wr) == 0:
+        return reach
+    obstacles = f.centre_of(wr + window[0].start, wc + window[1].start)
+    s = np.arange(0.0, reach + f.resolution / 2, f.resolution / 2)
+    if abs(curvature) < 1e-6:
+        dx, dy = s, np.zeros_like(s)
+    else:
+        dx, dy = np.sin(curvature * s) / curvature, (1.0 - np.cos(curvature * s)) / curvature
+    c, sn = math.cos(pose.theta), math.sin(pose.theta)
+    centres = np.column_stack((pose.x + c * dx - sn * dy, pose.y + sn * dx + c * dy))
+    nearest = np.min(np.hypot(centres[:, None, 0] - obstacles[None, :, 0], centres[:, None, 1] - obstacles[None, :, 1]),
+                     axis=1)
+    closing = (nearest < room) & (nearest < nearest[0] - f.resolution / 4.0)  # grazing along a wall is not closing
+    hit = np.flatnonzero(closing)
+    return float(s[hit[0]]) if len(hit) else reach
+
+
+@register
+class FollowPath(BearingsBehaviour):
+    """Follow the exploration goal's path with collision checks; RUNNING for ever, FAILURE when blocked.
+
+    See :mod:`behaviours.exploration.follow_path` for the control and the safety checks.
+    """
+
+    SPEED = InputPort("speed", float, 0.4, unit="m/s", minimum=0.01, maximum=1.2, doc="top speed")
+    SPEED_LIMIT = InputPort("speed_limit", float, 1.2, unit="m/s", minimum=0.0, maximum=5.0,
+                            doc="a further cap (the gaze's eq. 4: {/robot/speed_limit})")
+    TURN_RATE = InputPort("turn_rate", float, 60.0, unit="deg/s", minimum=1.0, maximum=300.0, literal_only=True,
+                          doc="top turn rate")
+    TOLERANCE = InputPort("tolerance", float, 0.3, unit="m", minimum=0.01, maximum=5.0, literal_only=True,
+                          doc="stop this close to the goal")
+    LOOKAHEAD = InputPort("lookahead", float, 0.4, unit="m", minimum=0.05, maximum=5.0, literal_only=True,
+                          doc="steer towards the path point this far ahead")
+    TURN_IN_PLACE = InputPort("turn_in_place", float, 35.0, unit="deg", minimum=1.0, maximum=180.0,
+                              literal_only=True, doc="turn on the spot when the carrot is this far off the heading")
+    CHECK_DISTANCE = InputPort("check_distance", float, 0.8, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
+                               doc="how much of the path ahead must stay clear")
+    MARGIN = InputPort("margin", float, 0.3, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
+                       doc="re-planned paths: steps with less clearance than robot_radius + margin cost more")
+    PENALTY = InputPort("penalty", float, 3.0, minimum=0.0, maximum=100.0, literal_only=True,
+                        doc="...up to (1 + penalty) times their length")
+    BACKOFF = InputPort("backoff", float, 1.0, unit="s", minimum=0.0, maximum=10.0, literal_only=True,
+                        doc="after a stall, back away this long")
+    MAX_STALLS = InputPort("max_stalls", int, 3, minimum=1, maximum=100, literal_only=True,
+                           doc="stalls on one goal before giving it up")
+    GUARD = InputPort("guard", float, 1.0, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
+                      doc="how much of the path ahead must be seen floor before the cameras may look elsewhere")
+    STUCK_TIME = InputPort("stuck_time", float, 8.0, unit="s", minimum=0.5, maximum=600.0, literal_only=True,
+                           doc="give the goal up after this long without progress")
+    UNSEEN_MARGIN = InputPort("unseen_margin", float, 0.3, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
+                              doc="brake to a crawl this far before unseen floor ahead (the cameras can still see it)")
+    CRAWL = InputPort("crawl", float, 0.1, unit="m/s", minimum=0.0, maximum=1.0, literal_only=True,
+                      doc="the speed from there on, until the disc would touch it")
+    FRONT = InputPort("front", float, 60.0, unit="deg", minimum=0.0, maximum=180.0, literal_only=True,
+                      doc="unseen floor within this of the direction of travel holds the robot (180: the whole disc)")
+    UNSEEN_AHEAD: OutputPort[Pose2D | None] = OutputPort(
+        "unseen_ahead", Pose2D, "/robot/unseen_ahead",
+        doc="the first point of the path ahead whose disc covers unseen floor (None: none)")
+    PORTS = (SPEED, SPEED_LIMIT, TURN_RATE, TOLERANCE, LOOKAHEAD, TURN_IN_PLACE, CHECK_DISTANCE, CLEARANCE,
+             ROBOT_RADIUS, MARGIN, PENALTY, BACKOFF, MAX_STALLS, GUARD, STUCK_TIME, UNSEEN_MARGIN, CRAWL, FRONT,
+             GOAL, MAP, POSE, STALLED, COMMAND, UNSEEN_AHEAD)
+
+    def __init__(self, name: str | None = None, **ports: Any) -> None:
+        super().__init__(name=name, **ports)
+        self.goal: Goal | None = None
+        self.path = np.zeros((0, 2))
+        self.index = 0
+        self.stalls = 0
+        self.total_stalls = 0
+        self.backing_until = -math.inf
+        self.replans = 0
+        self.safety_stops = 0
+        self.blind_stops = 0
+        self.stuck = 0
+        self.progress: tuple[float, float] = (math.inf, 0.0)  # best path length left, and when
+        self._drawn: np.ndarray | None = None  # the path last drawn
+
+    def initialise(self) -> None:
+        self.goal, self.path, self.index, self.stalls = None, np.zeros((0, 2)), 0, 0
+        self.backing_until = -math.inf
+
+    def command(self, v: float, w: float) -> None:
+        self.set_output(COMMAND, VelocityCommand(v, w))
+
+    def update(self) -> Status:
+        pose = self.get_input(POSE, None)
+        m = self.get_input(MAP, None)
+        self.set_output(self.UNSEEN_AHEAD, None)
+        if pose is None or m is None:
+            self.feedback_message = "waiting for a pose and the map"
+            return Status.RUNNING
+        if self.get_input(STALLED, False) and self.now() >= self.backing_until:
+            self.stalls += 1
+            self.total_stalls += 1
+            if self.stalls > self.get_input(self.MAX_STALLS):
+                self.command(0.0, 0.0)
+                self.feedback_message = f"stalled {self.stalls} times: giving the goal up"
+                return Status.FAILURE
+            self.backing_until = self.now() + self.get_input(self.BACKOFF)
+        if self.now() < self.backing_until:
+            self.command(-0.1, 0.0)
+            self.feedback_message = "stalled: backing away"
+            return Status.RUNNING
+        goal = self.get_input(GOAL, None)
+        if goal is None:
+            self.command(0.0, 0.0)
+            self.feedback_message = "no goal"
+            return Status.RUNNING
+        if goal is not self.goal:
+            fresh = self.goal is None or math.dist(goal.target, self.goal.target) > 0.25
+            self.goal, self.path, self.index = goal, np.asarray(goal.path), 0
+            if fresh:
+                self.stalls, self.progress = 0, (math.inf, self.now())
+        return self._follow(pose, m, goal)
+
+    def _follow(self, pose: Pose2D, m: ExplorationMap, goal: Goal) -> Status:
+        here = np.array([pose.x, pose.y])
+        if math.dist(goal.target, here) <= self.get_input(self.TOLERANCE) or len(self.path) == 0:
+            self.command(0.0, 0.0)
+            self.feedback_message = "at the goal"
+            return Status.RUNNING
+        if self._blocked(m):
+            self.replans += 1
+            planned = self.get_input(ROBOT_RADIUS) + self.get_input(CLEARANCE)
+            travel = travel_cost(m, (pose.x, pose.y), planned,
+                                 margin=self.get_input(self.MARGIN), penalty=self.get_input(self.PENALTY))
+            self.path, self.index = travel.path_to(goal.target), 0
+            if len(self.path) == 0 or self._blocked(m):
+                self.command(0.0, 0.0)
+                self.feedback_message = "the goal cannot be reached any more"
+                return Status.FAILURE
+        self.index = self._nearest(here)
+        carrot, remaining = self._carrot(here)
+        if remaining < self.progress[0] - 0.05:
+            self.progress = (remaining, self.now())
+        elif self.now() - self.progress[1] > self.get_input(self.STUCK_TIME):
+            self.stuck += 1
+            self.command(0.0, 0.0)
+            self.feedback_message = f"no progress for {self.get_input(self.STUCK_TIME):g} s: giving the goal up"
+            return Status.FAILURE
+        error = wrap_angle(math.atan2(carrot[1] - pose.y, carrot[0] - pose.x) - pose.theta)
+        top_w = math.radians(self.get_input(self.TURN_RATE))
+        w = ramp(error, top_w, ANGULAR_DECEL, 0.0) if error else 0.0
+        seen = self._seen_distance(m, here)
+        if abs(error) > math.radians(self.get_input(self.TURN_IN_PLACE)):
+            self.command(0.0, w)
+            self.feedback_message = f"turning towards the path ({math.degrees(error):+.0f} deg)"
+            return Status.RUNNING
+        see = self.get_input(self.UNSEEN_MARGIN)  # brake to a crawl where the cameras can still see it
+        crawl = self.get_input(self.CRAWL) if seen > m.frame.resolution else 0.0
+        blind = max(math.sqrt(2.0 * LINEAR_DECEL * max(seen - see, 0.0)), crawl)
+        v = min(ramp(remaining, self.get_input(self.SPEED), LINEAR_DECEL, 0.02),
+                self.get_input(self.SPEED_LIMIT, math.inf), blind)
+        v = max(0.0, v * math.cos(error))
+        self.blind_stops += int(blind < 0.02)
+        room = self.get_input(ROBOT_RADIUS) + self.get_input(CLEARANCE)
+        reach = self.get_input(self.SPEED) ** 2 / (2.0 * LINEAR_DECEL) + 0.1
+        free = free_travel(m, pose, w / max(v, 0.05), room, reach)
+        v = min(v, math.sqrt(2.0 * LINEAR_DECEL * max(free - m.frame.resolution, 0.0)))  # stops in time
+        if free < reach:
+            self.safety_stops += int(v < 0.02)
+        self.command(v, w)
+        self.feedback_message = f"{remaining:.2f} m to go" + ("" if math.isinf(seen) else f", {seen:.2f} m seen")
+        return Status.RUNNING
+
+    def _nearest(self, here: np.ndarray) -> int:
+        """The path point nearest the robot, searching forward from the last one (no going back)."""
+        window = self.path[self.index : self.index + 40]
+        return self.index + int(np.argmin(np.hypot(*(window - here).T)))
+
+    def _carrot(self, here: np.ndarray) -> tuple[np.ndarray, float]:
+        """The first path point ``lookahead`` away from the robot, and the path length left."""
+        ahead = self.path[self.index :]
+        steps = np.hypot(*np.diff(ahead, axis=0).T) if len(ahead) > 1 else np.zeros(0)
+        remaining = float(steps.sum()) + float(np.hypot(*(ahead[0] - here)))
+        far = np.flatnonzero(np.hypot(*(ahead - here).T) >= self.get_input(self.LOOKAHEAD))
+        return (ahead[far[0]] if len(far) else ahead[-1]), remaining
+
+    def _blocked(self, m: ExplorationMap) -> bool:
+        """Does the path's next ``check_distance`` bring the disc onto an obstacle cell?"""
+        ahead = self.path[self.index :]
+        if len(ahead) == 0:
+            return False
+        along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ahead, axis=0).T))))
+        near = ahead[along <= self.get_input(self.CHECK_DISTANCE)]
+        return bool(np.any(disc_cells(m, near, self.get_input(ROBOT_RADIUS)) == Cell.OBSTACLE))
+
+    def _seen_distance(self, m: ExplorationMap, here: np.ndarray) -> float:
+        """Distance to the first point of the path ahead (within ``guard``) where the front of the disc
+        (within ``front`` of the direction of travel) covers an unknown cell that the disc does not
+        cover now (inf: none). The unknown cells found there go to ``unseen_ahead`` (their centroid).
+        Unknown cells under the robot already (at the start, after a recovery) do not hold it, nor
+        unknown floor beside the path: the cameras cannot see within ~0.5 m of the lens, so the floor
+        beside a path along a border would never become seen from it."""
+        radius = self.get_input(ROBOT_RADIUS)
+        ahead = self.path[self.index :]
+        along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ahead, axis=0).T))))
+        cos_front = math.cos(math.radians(self.get_input(self.FRONT)))
+        for k, (point, s) in enumerate(zip(ahead, along, strict=True)):
+            if s > self.get_input(self.GUARD):
+                break
+            centres, rel, dist, states = cells_around(m, point, radius)
+            heading = ahead[min(k + 1, len(ahead) - 1)] - ahead[max(k - 1, 0)]
+            heading = heading / max(float(np.hypot(*heading)), 1e-9)
+            new = (dist <= radius) & (np.hypot(*(centres - here).T) > radius) & (rel @ heading >= cos_front * dist)
+            unknown = states == Cell.UNKNOWN
+            if np.any(unknown & new):
+                centroid = centres[unknown & new].mean(axis=0)
+                self.set_output(self.UNSEEN_AHEAD, Pose2D(float(centroid[0]), float(centroid[1])))
+                return float(np.hypot(*(point - here)))
+        return math.inf
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status != Status.RUNNING:
+            self.set_output(COMMAND, STOP)
+            self.set_output(self.UNSEEN_AHEAD, None)
+
+    def figures(self) -> Iterator[Figure]:
+        """The ``exploration`` section's driving part: stalls, re-plans, safety stops."""
+        yield from (Figure("exploration", name, value) for name, value in (
+            ("stalls", self.total_stalls), ("replans", self.replans), ("stuck", self.stuck),
+            ("safety_stops", self.safety_stops), ("blind_stops", self.blind_stops)))
+
+    def drawings(self) -> Iterator[Drawing]:
+        """The path being followed (odometry frame), when it changed."""
+        if len(self.path) < 2 or self._drawn is self.path:
+            return
+        self._drawn = self.path
+        yield Lines("odometry_frame/exploration/followed", [self.path], (255, 255, 255), radius=0.015)

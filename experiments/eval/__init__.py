@@ -1,0 +1,47 @@
+"""Evaluations behind ``bearings eval AREA``: one module per area, run through the sweep runner.
+
+An area module exposes ``DESCRIPTION`` (one line), ``check_world(world)`` (raises ``InputError`` or
+``ValueError`` for a world it cannot evaluate), ``run(options: EvalOptions, *, resume: bool) -> dict``
+(one JSON object of named figures) and ``format_table(figures) -> str`` (the readable form). Every
+episode goes through :func:`experiments.sweep.run_sweep` with the executor the command built (a local
+process pool or a Dask cluster), on any world file the simulator reads. Evaluations may use the
+simulator's ground truth (the run reports' ``ground_truth`` sections); the behaviours they evaluate
+never do.
+
+An area with options of its own declares them in ``OPTIONS`` (name -> one-line help). The command
+takes them as ``--option NAME=VALUE`` (repeatable; a name the area does not declare is refused) and
+passes them on as text in :attr:`EvalOptions.extra`; when the module has ``check_options(world,
+extra)``, that may refuse a bad value (``ValueError``, exit 2) before any episode runs.
+
+To add an area, write its module and name it in :data:`AREAS`.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import Executor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+AREAS = {
+    "exploration": "experiments.eval.exploration",
+    "ltmap": "experiments.eval.ltmap",
+    "roadmap": "experiments.eval.roadmap",
+}
+
+
+@dataclass
+class EvalOptions:
+    """What every evaluation is given: where, how many seeds, how to run the episodes."""
+
+    world: str
+    seeds: list[int]
+    executor: Executor
+    results_dir: Path  # the sweep's folder: results.jsonl, reports/<id>.json
+    timeout_s: float | None = None  # wall-clock limit per episode
+    max_time_s: float | None = None  # each episode's --max-time (simulated seconds); None: the mission's
+    progress: TextIO | None = None
+    extra: dict[str, str] = field(default_factory=dict)  # the area's own options (--option NAME=VALUE)
+    # what the area's check_world and check_options (or None) returned for these inputs, when the
+    # caller has checked them already (the command does, before any episode); None: run() checks
+    checked: tuple[Any, Any] | None = None

@@ -1,0 +1,285 @@
+"""``bearings eval exploration``: explored floor against path length and time, three ways.
+
+Three variants of the shipped ``explore`` mission, each over the same seeds:
+
+- ``method``: attractive power (eq. 1) with frontier mode, the cameras watching interest edges;
+- ``baseline``: the closest reachable border always (classic frontier exploration), cameras fixed
+  straight ahead;
+- ``fixed``: the method's goal selection with the cameras fixed straight ahead (so method vs fixed
+  measures the gaze, fixed vs baseline the goal selection).
+
+The measure (ground truth, evaluation only). The reference is the world's reachable floor
+(:func:`drivers.sim.floor.reachable_floor`: where the robot's centre can go from the start). What
+was *explored* is what the cameras actually saw: every stereo observation is in the run report as
+a virtual range scan (``exploration.scans``: time, pan, tilt, free range per 1-degree bin), and is
+drawn again here at the robot's TRUE pose at that time (interpolated in the report's ground-truth
+trajectory), together with the disc the robot's body covered along that trajectory. That counts
+floor the robot saw, wherever its own map put it; a scan whose range was cut short by a false
+obstacle counts less, and floor its map shows at a drifted place does not count twice. Coverage
+is the fraction of reachable cells so explored. For comparison, ``coverage_map`` places the
+robot's own final map (odometry frame) at the true start pose (its error is the localisation's),
+and ``map_on_obstacles_m2`` is how much of that map's explored floor lies on walls and furniture.
+
+Figures per variant (means over seeds unless named otherwise): final ``coverage``, its minimum,
+``ok`` (episodes that ended by themselves with coverage >= 0.95 and no collision), ``done``,
+``collisions``, ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
+and after 60, 120 and 240 s, and the path length and time to reach 50, 80, 90 and 95 % (None when
+not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m to
+the two others'.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import cv2
+import numpy as np
+
+from drivers.sim.floor import FloorGrid, reachable_floor
+from drivers.sim.simulation import start_to_world
+from drivers.sim.world import load_world
+from experiments.eval import EvalOptions
+from experiments.eval.trajectory import TrueTrajectory
+from experiments.sweep import Episode, run_sweep
+from experiments.sweep.table import read_report
+from maps.exploration.codec import unpack_cells
+from maps.exploration.grid import GridFrame
+from maps.exploration.head import StereoHead
+from maps.exploration.integrate import scan_cells
+from perception.geometry import Pose2D
+
+DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed"
+MISSION = "explore"
+VARIANTS: dict[str, dict[str, str]] = {
+    "method": {"strategy": "attraction", "gaze": "edges"},
+    "baseline": {"strategy": "closest_frontier", "gaze": "fixed"},
+    "fixed": {"strategy": "attraction", "gaze": "fixed"},
+}
+DISTANCES = (5.0, 10.0, 20.0, 40.0)  # m of path: coverage reached by then
+TIMES = (60.0, 120.0, 240.0)  # s
+LEVELS = (0.5, 0.8, 0.9, 0.95)  # coverage: path length and time to reach it
+RESOLUTION = 0.05  # m: the reference floor grid
+GOAL = 0.95  # the issue's criterion
+
+
+def check_world(world: str) -> FloorGrid:
+    """The reachable floor of ``world``; ``ValueError`` when it has none to measure against."""
+    floor = reachable_floor(load_world(world), resolution=RESOLUTION)
+    if not floor.bounded:
+        raise ValueError(f"world {world!r} is open (its reachable floor runs off the map): nothing to explore "
+                         "to the end")
+    return floor
+
+
+def episodes(world: str, seeds: Sequence[int], max_time_s: float | None = None) -> list[Episode]:
+    """The evaluation's runs: every variant on every seed."""
+    return [Episode(MISSION, world, seed, inputs, max_time_s) for inputs in VARIANTS.values() for seed in seeds]
+
+
+def variant_of(inputs: dict[str, Any]) -> str:
+    for name, values in VARIANTS.items():
+        if all(str(inputs.get(k)) == v for k, v in values.items()):
+            return name
+    raise KeyError(f"no variant has the inputs {inputs}")
+
+
+# ------------------------------------------------------------------------------------------------
+# What was seen, at the true poses
+
+
+def seen_floor(report: dict[str, Any], floor: FloorGrid, robot_radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """The cells (bool, the floor grid's) seen at the true poses, and the coverage curve as rows of
+    (time s, true path length m, coverage of the reachable floor), in time order."""
+    exploration, truth = report.get("exploration", {}), report["ground_truth"]
+    trajectory = TrueTrajectory(truth)
+    frame = GridFrame(floor.x0, floor.y0, floor.resolution, *floor.reachable.shape)
+    seen = np.zeros(frame.shape, dtype=np.uint8)
+    disc = int(round(robot_radius / floor.resolution))
+    events: list[tuple[float, int, Any]] = [(float(t), 0, i) for i, t in enumerate(trajectory.t)]
+    scans = exploration.get("scans", [])
+    events += [(float(row[0]), 1, row) for row in scans]
+    header = exploration.get("scan", {})
+    head = StereoHead(tuple(header["ptu"]), tuple(header["camera"]), header["vertical_fov"],
+                      header["horizontal_fov"]) if scans else StereoHead()
+    edges = np.linspace(-head.horizontal_fov / 2.0, head.horizontal_fov / 2.0, int(header.get("bins", 1)) + 1)
+    total = max(int(np.count_nonzero(floor.reachable)), 1)
+    curve = []
+    for t, kind, item in sorted(events, key=lambda e: (e[0], e[1])):
+        if kind == 0:  # the robot's body covers the floor it stands on
+            if disc == 0:
+                continue
+            rows, cols, _ = floor.cells_of(trajectory.xy[item])
+            cv2.circle(seen, (int(cols[0]), int(rows[0])), disc, 1, -1)
+        else:
+            view = head.view(trajectory.interpolated(t), float(item[1]), float(item[2]))
+            seen |= scan_cells(frame, view, edges, np.asarray(item[3:], dtype=np.float64)).astype(np.uint8)
+            curve.append((t, trajectory.path_length(t), np.count_nonzero(seen.astype(bool) & floor.reachable) / total))
+    coverage = np.count_nonzero(seen.astype(bool) & floor.reachable) / total
+    curve.append((float(trajectory.t[-1]), float(trajectory.length[-1]), coverage))
+    return seen.astype(bool), np.asarray(curve, dtype=np.float64).reshape(-1, 3)
+
+
+def map_in_world(report: dict[str, Any]) -> np.ndarray:
+    """The robot's own explored cells (N x 2 points, nine per cell) placed in the world at the true start pose."""
+    m = report.get("exploration", {}).get("map")
+    if not m:
+        return np.zeros((0, 2))
+    explored = unpack_cells(m["explored"], m["rows"], m["cols"])
+    frame = GridFrame(m["x0"], m["y0"], m["resolution"], m["rows"], m["cols"])
+    rows, cols = np.nonzero(explored)
+    sub = (np.arange(3) - 1.0) / 3.0  # 3 x 3 points per cell: a rotated grid of the same size leaves no holes
+    offsets = np.array([(a, b) for a in sub for b in sub]) * frame.resolution
+    local = (frame.centre_of(rows, cols)[:, None, :] + offsets[None, :, :]).reshape(-1, 2)
+    _, x0, y0, th0 = report["ground_truth"]["trajectory"][0]
+    return start_to_world(Pose2D(x0, y0, th0), local)
+
+
+def _first(curve: np.ndarray, level: float, column: int) -> float | None:
+    hit = np.flatnonzero(curve[:, 2] >= level)
+    return float(curve[hit[0], column]) if len(hit) else None
+
+
+def episode_figures(report: dict[str, Any] | None, floor: FloorGrid, robot_radius: float) -> dict[str, Any]:
+    """Figures of one run (see the module docstring); an episode without a report has coverage 0."""
+    if report is None or "ground_truth" not in report:
+        return {"status": "ERROR", "coverage": 0.0, "ok": False, "done": False}
+    truth = report["ground_truth"]
+    seen, curve = seen_floor(report, floor, robot_radius)
+    placed = map_in_world(report)
+    rows, cols, inside = floor.cells_of(placed)
+    cells = np.unique(rows[inside] * floor.free.shape[1] + cols[inside])
+    on_obstacles = int(np.count_nonzero(~floor.free.ravel()[cells]))
+    coverage = float(curve[-1, 2])
+    done = report["status"] == "SUCCESS"
+    out: dict[str, Any] = {
+        "status": report["status"],
+        "reason": report.get("reason", ""),
+        "done": done,
+        "coverage": coverage,
+        "coverage_map": floor.coverage(placed) if len(placed) else 0.0,
+        "map_on_obstacles_m2": on_obstacles * floor.resolution**2,
+        "collisions": int(truth.get("collisions", 0)),
+        "path_length_m": float(truth["trajectory_length_m"]),
+        "sim_time_s": float(report.get("sim_time_s", truth.get("sim_time_s", 0.0))),
+        "odometry_drift_m": float(truth.get("odometry_drift_m", math.nan)),
+        "wall_time_s": float(report.get("wall_time_s", math.nan)),
+    }
+    out["ok"] = bool(done and coverage >= GOAL and out["collisions"] == 0)
+    for d in DISTANCES:
+        out[f"coverage_at_{d:g}m"] = _coverage_when(curve, d, 1)
+    for t in TIMES:
+        out[f"coverage_at_{t:g}s"] = _coverage_when(curve, t, 0)
+    for level in LEVELS:
+        out[f"path_to_{level * 100:g}pct_m"] = _first(curve, level, 1)
+        out[f"time_to_{level * 100:g}pct_s"] = _first(curve, level, 0)
+    exploration = report.get("exploration", {})
+    for key in ("goal_count", "mode_switch_count", "gaze_watching_fraction", "gaze_look_ahead_fraction", "stuck",
+                "goals_abandoned"):
+        if key in exploration:
+            out[key] = exploration[key]
+    return out
+
+
+def _coverage_when(curve: np.ndarray, value: float, column: int) -> float:
+    """Coverage when ``column`` (0: time, 1: path length) reached ``value``; the final coverage when the
+    run ended before (an ended exploration explores no more)."""
+    before = np.flatnonzero(curve[:, column] <= value)
+    return float(curve[before[-1], 2]) if len(before) else 0.0
+
+
+# ------------------------------------------------------------------------------------------------
+# The evaluation
+
+
+def _mean(values: Sequence[float | None]) -> float | None:
+    """Mean of the values; None when any is None (a level some episode never reached)."""
+    if not values or any(v is None for v in values):
+        return None
+    return float(np.mean([float(v) for v in values if v is not None]))
+
+
+CURVE_FIGURES = (  # per-episode figures averaged over a variant's runs and shown in its table
+    *(f"coverage_at_{d:g}m" for d in DISTANCES), *(f"coverage_at_{t:g}s" for t in TIMES),
+    *(f"path_to_{v * 100:g}pct_m" for v in LEVELS), *(f"time_to_{v * 100:g}pct_s" for v in LEVELS),
+    "goal_count", "mode_switch_count", "gaze_watching_fraction", "gaze_look_ahead_fraction",
+)
+
+
+def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """Per-variant figures over its episodes."""
+    coverage = [r["coverage"] for r in runs]
+    out: dict[str, Any] = {
+        "episodes": len(runs),
+        "ok": sum(bool(r["ok"]) for r in runs),
+        "done": sum(bool(r["done"]) for r in runs),
+        "coverage": float(np.mean(coverage)),
+        "coverage_min": float(np.min(coverage)),
+        "coverage_std": float(np.std(coverage, ddof=1)) if len(runs) > 1 else 0.0,
+    }
+    if any(r["status"] == "ERROR" for r in runs):
+        out["errors"] = sum(r["status"] == "ERROR" for r in runs)
+    good = [r for r in runs if r["status"] != "ERROR"]
+    for key in ("coverage_map", "map_on_obstacles_m2", "path_length_m", "sim_time_s", *CURVE_FIGURES):
+        values = [r.get(key) for r in good]
+        if good and any(key in r for r in good):
+            out[key] = _mean(values)
+    out["collisions"] = sum(int(r.get("collisions", 0)) for r in good)  # a count over the runs, not a mean
+    return out
+
+
+def _ratio(a: float | None, b: float | None) -> float | None:
+    return None if a is None or b is None or b == 0 else a / b
+
+
+def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
+    """Run the episodes through the sweep runner and compute the figures."""
+    floor = options.checked[0] if options.checked else check_world(options.world)
+    world = load_world(options.world)
+    todo = episodes(options.world, options.seeds, options.max_time_s)
+    rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,
+                     progress=options.progress, resume=resume)
+    by_variant: dict[str, list[dict[str, Any]]] = {name: [] for name in VARIANTS}
+    runs = []
+    for row in rows:
+        report = read_report(options.results_dir, row["id"])
+        variant = variant_of({k[len("inputs."):]: v for k, v in row.items() if k.startswith("inputs.")})
+        figures = episode_figures(report, floor, world.robot_radius)
+        by_variant[variant].append(figures)
+        runs.append({"variant": variant, "seed": row["seed"], **{k: v for k, v in figures.items() if k != "reason"}})
+    out: dict[str, Any] = {
+        "world": world.name,
+        "seeds": len(options.seeds),
+        "episodes": len(rows),
+        "reachable_area_m2": floor.reachable_area,
+        "criterion": f"ended by itself, coverage >= {GOAL:g}, no collision",
+    }
+    summary = {name: summarise_variant(v) for name, v in by_variant.items() if v}
+    for name, figures in summary.items():
+        out.update({f"{name}.{key}": value for key, value in figures.items()})
+    for other in ("fixed", "baseline"):
+        for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s"):
+            out[f"method_vs_{other}.{key}_ratio"] = _ratio(summary["method"].get(key), summary[other].get(key))
+        out[f"method_vs_{other}.path_length_ratio"] = _ratio(summary["method"].get("path_length_m"),
+                                                              summary[other].get("path_length_m"))
+    out["runs"] = sorted(runs, key=lambda r: (r["variant"], r["seed"]))
+    return out
+
+
+def format_table(figures: dict[str, Any]) -> str:
+    """The comparison as a readable table (one column per variant)."""
+    keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "collisions", "path_length_m", "sim_time_s",
+            *CURVE_FIGURES]
+    names = [n for n in VARIANTS if f"{n}.coverage" in figures]
+    lines = [f"exploration in {figures['world']}: {figures['seeds']} seed(s), reachable floor "
+             f"{figures['reachable_area_m2']:.1f} m^2 ({figures['criterion']})",
+             "figure".ljust(24) + "".join(n.rjust(12) for n in names)]
+    for key in keys:
+        cells = []
+        for name in names:
+            value = figures.get(f"{name}.{key}")
+            text = "-" if value is None else f"{value:.3g}" if isinstance(value, float) else str(value)
+            cells.append(text.rjust(12))
+        lines.append(key.ljust(24) + "".join(cells))
+    return "\n".join(lines)

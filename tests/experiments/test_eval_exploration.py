@@ -1,0 +1,116 @@
+"""The exploration evaluation: what was seen at the true poses, the figures, the command."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drivers.sim.world import load_world
+from experiments.eval.exploration import check_world, episode_figures, episodes, seen_floor, summarise_variant
+from maps.exploration.codec import pack_cells
+from maps.exploration.head import StereoHead, footprint
+from missions.cli import main
+from perception.geometry import Pose2D
+
+BOX = str(Path(__file__).resolve().parents[1] / "data" / "worlds" / "box.yaml")
+HEAD = StereoHead()
+
+
+def report(scans: list[list[float]], trajectory: list[list[float]], **extra) -> dict:
+    bins = math.ceil(math.degrees(HEAD.horizontal_fov))
+    exploration = {"scans": scans, "scan": {"ptu": list(HEAD.ptu), "camera": list(HEAD.camera),
+                                            "vertical_fov": HEAD.vertical_fov,
+                                            "horizontal_fov": HEAD.horizontal_fov, "bins": bins}, **extra}
+    length = float(np.sum(np.hypot(*np.diff(np.array(trajectory)[:, 1:3], axis=0).T))) if len(trajectory) > 1 else 0.0
+    return {"status": "SUCCESS", "sim_time_s": trajectory[-1][0], "exploration": exploration,
+            "ground_truth": {"trajectory": trajectory, "trajectory_length_m": length, "collisions": 0}}
+
+
+def test_a_scan_is_drawn_at_the_true_pose():
+    floor = check_world(BOX)
+    tilt = math.radians(-30.0)
+    bins = math.ceil(math.degrees(HEAD.horizontal_fov))
+    r = report([[1.0, 0.0, tilt, *([1.2] * bins)]], [[0.0, 0.8, 0.8, 0.0], [2.0, 0.8, 0.8, 0.0]])
+    seen, curve = seen_floor(r, floor, robot_radius=0.0)
+    view = HEAD.view(Pose2D(0.8, 0.8, 0.0), 0.0, tilt)
+    _, near, _ = footprint(view)
+    half = HEAD.horizontal_fov / 2.0
+    area = half * 1.2**2 - near**2 * math.tan(half)  # the wedge to 1.2 m less the triangle before the near edge
+    perimeter = 2 * half * 1.2 + 2 * (1.2 - near / math.cos(half)) + 2 * near * math.tan(half)
+    drawn = np.count_nonzero(seen) * floor.resolution**2
+    assert area < drawn < area + perimeter * floor.resolution  # cv2 fills every cell the edges touch
+    xs = floor.x0 + (np.nonzero(seen)[1] + 0.5) * floor.resolution
+    assert xs.min() > 0.8 + HEAD.ptu[0] and xs.max() <= 0.8 + HEAD.ptu[0] + HEAD.camera[0] + 1.2 + 0.05
+    assert curve[0, :2] == pytest.approx([1.0, 0.0]) and curve[-1, 2] == pytest.approx(curve[0, 2])
+
+
+def test_the_true_pose_is_interpolated_and_the_robot_covers_its_disc():
+    floor = check_world(BOX)
+    trajectory = [[0.0, 0.8, 0.8, 0.0], [10.0, 2.0, 0.8, 0.0]]
+    seen, curve = seen_floor(report([], trajectory), floor, robot_radius=0.26)
+    def at(x: float) -> bool:
+        return bool(seen[floor.cells_of(np.array([[x, 0.8]]))[:2]].all())
+
+    assert at(0.8) and at(2.0) and not at(1.4)  # two rows: two discs, nothing between
+    bins = math.ceil(math.degrees(HEAD.horizontal_fov))
+    r = report([[5.0, 0.0, -0.5, *([1.0] * bins)]], trajectory)
+    seen, curve = seen_floor(r, floor, robot_radius=0.0)
+    xs = floor.x0 + (np.nonzero(seen)[1] + 0.5) * floor.resolution
+    assert xs.min() > 1.4  # drawn from (1.4, 0.8), halfway
+    assert curve[0, 1] == pytest.approx(0.6)  # true path length by then
+
+
+def test_episode_figures_and_the_criterion():
+    floor = check_world(BOX)
+    world = load_world(BOX)
+    trajectory = [[float(t), 0.8 + 0.1 * t, 0.8, 0.0] for t in range(15)]
+    m = {"x0": -1.0, "y0": -1.0, "resolution": 0.05, "rows": 60, "cols": 60,
+         "explored": pack_cells(np.ones((60, 60), dtype=bool))}
+    figures = episode_figures(report([], trajectory, map=m), floor, world.robot_radius)
+    assert figures["done"] and figures["collisions"] == 0 and figures["path_length_m"] == pytest.approx(1.4)
+    assert 0.0 < figures["coverage"] < 0.95 and not figures["ok"]
+    assert figures["coverage_map"] > figures["coverage"]  # the robot's map claims 3 x 3 m around the start
+    assert figures["coverage_at_5m"] == figures["coverage"]  # the run ended before 5 m: no more is explored
+    assert figures["path_to_95pct_m"] is None
+    assert episode_figures(None, floor, 0.26) == {"status": "ERROR", "coverage": 0.0, "ok": False, "done": False}
+    summary = summarise_variant([figures, episode_figures(None, floor, 0.26)])
+    assert summary["episodes"] == 2 and summary["errors"] == 1 and summary["coverage_min"] == 0.0
+
+
+def test_three_variants_per_seed():
+    runs = episodes("lab", [0, 1])
+    assert len(runs) == 6 and {e.inputs["gaze"] for e in runs} == {"edges", "fixed"}
+    assert {e.inputs["strategy"] for e in runs} == {"attraction", "closest_frontier"}
+
+
+def test_the_command_refuses_an_open_world_and_bad_numbers(capsys):
+    assert main(["eval", "exploration", "--world", "outdoor", "--seeds", "1"]) == 2
+    assert "open" in capsys.readouterr().err
+    assert main(["eval", "exploration", "--world", BOX, "--seeds", "0"]) == 2
+    assert main(["eval", "exploration", "--world", "no_such_world", "--seeds", "1"]) == 2
+
+
+def test_the_command_runs_the_episodes_through_the_sweep_runner(tmp_path, capsys):
+    code = main(["eval", "exploration", "--world", BOX, "--seeds", "1", "--workers", "2", "--max-time", "2",
+                 "-o", str(tmp_path / "out"), "--json"])
+    assert code == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert figures["area"] == "exploration" and figures["world"] == "box" and figures["episodes"] == 3
+    for variant in ("method", "baseline", "fixed"):
+        assert figures[f"{variant}.episodes"] == 1 and figures[f"{variant}.done"] == 0  # 2 s: not done
+        assert 0.0 < figures[f"{variant}.coverage"] < 1.0
+    assert len(figures["runs"]) == 3 and (tmp_path / "out" / "results.jsonl").exists()
+
+
+def test_episodes_that_all_fail_are_counted_not_a_crash(tmp_path, capsys):
+    code = main(["eval", "exploration", "--world", BOX, "--seeds", "1", "--workers", "1", "--timeout", "0.01",
+                 "-o", str(tmp_path / "out"), "--json"])
+    assert code == 0
+    figures = json.loads(capsys.readouterr().out)
+    for variant in ("method", "baseline", "fixed"):
+        assert figures[f"{variant}.errors"] == 1 and figures[f"{variant}.ok"] == 0
+    assert figures["method_vs_baseline.path_length_ratio"] is None

@@ -1,0 +1,132 @@
+"""One stereo observation into the exploration map: explored floor, obstacles, evidence, points, edges."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from maps.exploration.grid import Cell, ExplorationMap, mark_traversed
+from maps.exploration.integrate import integrate_observation, integrate_stereo, observe, scan_cells
+from maps.exploration.interest import Interest, closer_points
+from perception.geometry import Pose2D
+from tests.maps.exploration_maps import SIMPLE, apart, state_at
+
+
+def wall_observation(x: float = 2.05, z: float = 0.0) -> np.ndarray:
+    """Camera-frame points of a wall across the view at ``x`` (lens 1 m up, so world z = z + 1)."""
+    ys = np.linspace(-2.2, 2.2, 441)
+    return np.column_stack((np.full_like(ys, x), ys, np.full_like(ys, z)))
+
+
+def test_a_wall_explores_the_floor_between_the_footprint_and_the_wall():
+    m = ExplorationMap.empty(resolution=0.1, half_size=5.0)
+    points = wall_observation()
+    m = integrate_stereo(m, points, apart(points), SIMPLE.view(Pose2D(), 0.0, 0.0))
+    assert state_at(m, 1.55, 0.05) == Cell.FREE
+    assert state_at(m, 1.55, 1.05) == Cell.FREE  # inside the 90 degree field: |y| < x
+    assert state_at(m, 1.25, 1.65) == Cell.UNKNOWN  # outside the field
+    assert state_at(m, 0.55, 0.05) == Cell.UNKNOWN  # nearer than the footprint (lens 1 m up, 45 deg down)
+    assert state_at(m, 2.05, 0.05) == Cell.OBSTACLE
+    assert state_at(m, 2.05, 1.55) == Cell.OBSTACLE
+    assert state_at(m, 2.55, 0.05) == Cell.UNKNOWN  # behind the wall
+    # hand: the trapezoid 1 <= x <= 2.05, |y| <= x has 2.05^2 - 1 = 3.2 m^2
+    assert m.explored_area == pytest.approx(3.2025, rel=0.1)
+
+
+def test_floor_points_explore_up_to_the_explore_range_only():
+    xs, ys = np.meshgrid(np.linspace(1.0, 5.0, 81), np.linspace(-0.5, 0.5, 21))
+    floor = np.column_stack((xs.ravel(), ys.ravel(), np.full(xs.size, -1.0)))  # world z = 0
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), floor, apart(floor), SIMPLE.view(Pose2D(), 0.0, 0.0))
+    assert state_at(m, 2.85, 0.05) == Cell.FREE
+    assert state_at(m, 3.25, 0.05) == Cell.UNKNOWN
+    assert not np.any(m.cells == Cell.OBSTACLE)
+    assert len(m.points) > 0 and m.points[:, 2] == pytest.approx(np.zeros(len(m.points)))
+
+
+def test_points_above_the_robot_mark_nothing_but_are_kept():
+    ceiling = wall_observation(z=1.5)  # world z = 2.5, above obstacle_height
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), ceiling, apart(ceiling), SIMPLE.view(Pose2D(), 0.0, 0.0))
+    assert not np.any(m.cells != Cell.UNKNOWN)
+    assert len(m.points) == 45  # 441 points 1 cm apart in 0.1 m voxels
+
+
+def test_observations_use_the_odometry_pose_and_pan():
+    points = wall_observation()
+    view = SIMPLE.view(Pose2D(1.0, 1.0, math.pi / 2), pan=-math.pi / 2, tilt=0.0)  # looking along +x
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points), view)
+    assert state_at(m, 2.55, 1.05) == Cell.FREE
+    assert state_at(m, 3.05, 1.05) == Cell.OBSTACLE
+    assert m.points[:, 2] == pytest.approx(np.ones(len(m.points)))
+
+
+def test_obstacle_evidence_clears_when_the_floor_is_seen_there_again():
+    points = wall_observation()
+    view = SIMPLE.view(Pose2D(), 0.0, 0.0)
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points), view)
+    assert m.evidence[m.frame.cell_of(np.array([[2.05, 0.05]]))][0] == pytest.approx(0.85)
+    xs, ys = np.meshgrid(np.linspace(1.0, 2.9, 39), np.linspace(-0.3, 0.3, 13))
+    floor = np.column_stack((xs.ravel(), ys.ravel(), np.full(xs.size, -1.0)))
+    for sightings, expected in ((1, Cell.OBSTACLE), (2, Cell.OBSTACLE), (3, Cell.FREE)):  # 0.85 - n * 0.4
+        m = integrate_stereo(m, floor, apart(floor), view)
+        assert state_at(m, 2.05, 0.05) == expected, sightings
+    assert state_at(m, 2.55, 0.05) == Cell.FREE
+    assert state_at(m, 2.05, 0.55) == Cell.OBSTACLE  # outside the floor patch: still the wall
+
+
+def test_the_robots_disc_is_free_whatever_was_seen_there():
+    points = wall_observation()
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points), SIMPLE.view(Pose2D(), 0.0, 0.0))
+    m = mark_traversed(m, Pose2D(2.05, 0.05), 0.26)
+    assert state_at(m, 2.05, 0.05) == Cell.FREE and state_at(m, 2.05, 0.25) == Cell.FREE
+    assert state_at(m, 2.05, 0.45) == Cell.OBSTACLE
+
+
+def test_the_same_observation_twice_adds_nothing():
+    # a near wall on the right, a far one on the left, every point 5 px from the next in the image
+    near, far = wall_observation(2.05), wall_observation(4.05)
+    points = np.concatenate([near[near[:, 1] < 0], far[far[:, 1] >= 0]])
+    uv = np.column_stack((np.arange(len(points)) * 5.0, np.zeros(len(points))))
+    view = SIMPLE.view(Pose2D(), 0.0, 0.0)
+    once = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, uv, view)
+    twice = integrate_stereo(once, points, uv, view)
+    assert len(twice.points) == len(once.points) == 22 + 23  # 0.1 m voxels of y in [-2.2, 0) and [0, 2.2]
+    # only the neighbours across the depth jump make an edge (r = 2.05 / 4.05); along a wall r ~ 1
+    assert once.edges.tolist() == twice.edges.tolist() == [[21, 22]]
+    assert np.array_equal(twice.cells, once.cells)
+
+
+def test_image_neighbours_become_edges_with_their_interest():
+    # A and B are 5 px apart in the image but 2 m and 5 m away; C is far from both in the image
+    points = np.array([[2.0, 0.0, 0.0], [5.0, 0.0, 0.0], [3.0, -1.0, 0.0]])
+    uv = np.array([[320.0, 240.0], [325.0, 240.0], [500.0, 240.0]])
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, uv, SIMPLE.view(Pose2D(), 0.0, 0.0))
+    assert m.edges.tolist() == [[0, 1]]
+    assert m.interest.tolist() == [Interest.WATCH_NOW]  # r = 2/5, straight ahead
+    assert closer_points(m, np.array([0.0, 0.0, 1.0]))[0] == pytest.approx([2.0, 0.0, 1.0])
+
+
+def test_sightings_count_the_observations_of_each_voxel():
+    m = ExplorationMap.empty(resolution=0.1, half_size=2.0)
+    view = SIMPLE.view(Pose2D(), 0.0, math.radians(-45.0))
+    pts = np.array([[2.0, 0.0, -0.5], [2.01, 0.0, -0.5], [2.5, 0.5, -0.2]])  # the first two share a voxel
+    uv = np.array([[0.0, 0.0], [100.0, 0.0], [200.0, 0.0]])
+    once = integrate_stereo(m, pts, uv, view)
+    assert once.sightings.tolist() == [1, 1]
+    twice = integrate_stereo(once, pts[:1], uv[:1], view)
+    assert twice.sightings.tolist() == [2, 1]
+    assert ExplorationMap(m.frame, m.evidence, points=pts).sightings.tolist() == [1, 1, 1]
+
+
+def test_the_scan_of_an_observation_draws_again_what_was_explored():
+    """The range scan kept with an observation (the report's ``scans``) gives the same explored cells."""
+    points = wall_observation()
+    view = SIMPLE.view(Pose2D(), 0.0, 0.0)
+    seen = observe(points, apart(points), view)
+    assert len(seen.ranges) == 90 and seen.ranges[45] == pytest.approx(2.05, abs=1e-3)  # 1-degree bins; the wall ahead
+    m = integrate_observation(ExplorationMap.empty(resolution=0.1, half_size=5.0), seen)
+    drawn = scan_cells(m.frame, view, seen.scan_edges, seen.ranges)
+    assert np.array_equal(m.cells == Cell.FREE, drawn & (m.cells != Cell.OBSTACLE))  # the wall's cells are hits
+    assert np.array_equal(m.cells, integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points),
+                                                    view).cells)
