@@ -33,6 +33,9 @@ Figures (simulator ground truth, evaluation only), per repeat:
   apart no finer than its spacing (indoors a few decimetres, outdoors metres, where far landmarks
   change slowly). ``--option goal_tolerance=M`` fixes it instead.
 - ``viewframes_reached``: fraction of the map's viewframes the repeat switched past.
+- ``estimates_pct``: per rule, the percentage of the repeat's estimates it made (``FollowRoute``'s
+  ``ltmap.estimates``: a rung of Z-infinity's far-threshold ladder, the compass, no rotation, lost).
+- ``bytes_per_m``: the map's bytes at this height per metre of the taught route (true length).
 
 Maps are written by the teach episodes into the results folder and read by the repeats and by
 this module: on a Dask cluster (``--cluster``) that folder (``-o DIR``) must be one the workers and
@@ -58,6 +61,8 @@ from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
 from experiments.eval.figures import cell, mean_present
 from experiments.eval.ltmap_route import Route, default_route, given_route, parse_route
+from experiments.eval.ltmap_table import estimate_shares, memory_limits, row_figures
+from experiments.eval.ltmap_table import format_table as format_table  # the area's table (experiments.eval)
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.table import read_report
@@ -245,6 +250,12 @@ def viewframe_errors(teach: Run, repeat: Run) -> list[float]:
     return out
 
 
+def taught_length(teach: Run) -> float:
+    """The true length (m) of the taught route: the report's, else its decimated trajectory's."""
+    given = teach.report["ground_truth"].get("trajectory_length_m")
+    return float(given) if given is not None else float(teach.truth.length[-1])
+
+
 def repeat_figures(teach: Run, repeat: Mapping[str, Any] | None, level: Level,
                    tolerance: float) -> dict[str, Any]:
     """The figures of one repeat (module docstring); a repeat without a report reached nothing."""
@@ -267,38 +278,12 @@ def repeat_figures(teach: Run, repeat: Mapping[str, Any] | None, level: Level,
         "reached": bool(repeat["status"] == "SUCCESS" and goal_error <= tolerance),
         "viewframes_reached": len(reached) / max(level.viewframes, 1),
         "recoveries": int(section.get("recoveries", 0)),
+        "estimates_pct": estimate_shares(section.get("estimates") or {}),
+        "bytes_per_m": level.bytes / length if (length := taught_length(teach)) > 0 else None,
         "sim_time_s": float(repeat.get("sim_time_s", 0.0)),
         "map_as_expected": section.get("height") == level.height and section.get("bytes") == level.bytes,
     })
     return out
-
-
-def row_figures(runs: list[dict[str, Any]]) -> dict[str, Any]:
-    """One Table-I row: means over the seeds' repeats of one number of levels cut."""
-    heights = sorted({r["height"] for r in runs})
-    good = [r for r in runs if r.get("status") != "ERROR"]
-    reached = [r for r in runs if r["reached"]]
-    row: dict[str, Any] = {
-        "levels_cut": runs[0]["cut"],
-        "height": heights[0] if len(heights) == 1 else None,
-        "height_range": [heights[0], heights[-1]],
-        "seeds": len(runs),
-        "viewframes": mean_present([r["viewframes"] for r in runs]),
-        "landmarks": mean_present([r["landmarks"] for r in runs]),
-        "bytes": mean_present([r["bytes"] for r in runs]),
-        "memory_pct": 100.0 * (mean_present([r["memory_fraction"] for r in runs]) or 0.0),
-        "viewframe_error_m": mean_present([r.get("viewframe_error_m") for r in good]),
-        "path_error_m": mean_present([r.get("path_error_m") for r in good]),
-        "path_error_reached_m": mean_present([r.get("path_error_m") for r in reached]),
-        "goal_error_m": mean_present([r.get("goal_error_m") for r in good]),
-        "goal_reached": len(reached),
-        "viewframes_reached_pct": 100.0 * (mean_present([r.get("viewframes_reached") for r in good]) or 0.0),
-        "recoveries": mean_present([r.get("recoveries") for r in good]),
-        "sim_time_s": mean_present([r.get("sim_time_s") for r in good]),
-    }
-    if len(good) < len(runs):
-        row["errors"] = len(runs) - len(good)
-    return row
 
 
 # ------------------------------------------------------------------------------------------------
@@ -402,48 +387,3 @@ def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dic
     if any(not r.get("map_as_expected", True) for r in runs):
         out["warning"] = "some repeats followed a map other than the height planned (see runs[].map_as_expected)"
     return out
-
-
-def memory_limits(rows: list[dict[str, Any]]) -> dict[str, float | None]:
-    """As the paper puts it ("goal still reached at 57 % memory, lost at 35 %"): going down from the
-    full tree, the memory of the last row where every taught seed reached the goal, and of the first
-    row where one did not (None: no such row)."""
-    still, lost = None, None
-    for row in rows:  # a row of fewer seeds (their trees were not that tall) counts by the seeds it has
-        if row["goal_reached"] == row["seeds"]:
-            still = row["memory_pct"]
-        else:
-            lost = row["memory_pct"]
-            break
-    return {"goal_reached_down_to_memory_pct": still, "goal_first_missed_memory_pct": lost}
-
-
-def format_table(figures: Mapping[str, Any]) -> str:
-    """The rows as the paper's Table I, with the setting above them."""
-    route = f"{figures['route_source']} of {figures['route_length_m']:.1f} m"
-    lines = [
-        f"LT-map teach and repeat in {figures['world']}: {figures['seeds']} seed(s), camera {figures['camera']}, "
-        f"rotation {figures.get('rotation', 'zinf')}, route: {route}, taught {figures['taught']}/{figures['seeds']}",
-        f"goal reached: {figures['criterion']}; min_landmarks {figures['min_landmarks']}; path error of the repeats "
-        "that reached the goal (of all repeats)",
-        f"{'height':>6} {'cut':>3} {'viewframes':>10} {'landmarks':>9} {'memory %':>8} {'vf err m':>8} "
-        f"{'path err m':>16} {'goal err m':>10} {'vf reached %':>12} {'goal reached':>12}",
-    ]
-    for row in figures["rows"]:
-        low, high = row["height_range"]
-        height = str(low) if low == high else f"{low}-{high}"
-        path = f"{cell(row['path_error_reached_m'])} ({cell(row['path_error_m'])})"
-        lines.append(f"{height:>6} {row['levels_cut']:>3} {cell(row['viewframes'], 1):>10} "
-                     f"{cell(row['landmarks'], 0):>9} {cell(row['memory_pct'], 1):>8} "
-                     f"{cell(row['viewframe_error_m']):>8} {path:>16} {cell(row['goal_error_m']):>10} "
-                     f"{cell(row['viewframes_reached_pct'], 0):>12} {row['goal_reached']:>7} of {row['seeds']}"
-                     + (f"  ({row['errors']} errors)" if row.get("errors") else ""))
-    still, lost = figures.get("goal_reached_down_to_memory_pct"), figures.get("goal_first_missed_memory_pct")
-    if figures["rows"]:
-        lines.append(f"goal reached by every seed down to {cell(still, 1)} % memory; first missed at "
-                     f"{cell(lost, 1)} %")
-    for fail in figures["teach_failed"]:
-        lines.append(f"seed {fail['seed']}: no map to repeat ({fail['problem']})")
-    if figures.get("warning"):
-        lines.append(f"warning: {figures['warning']}")
-    return "\n".join(lines)

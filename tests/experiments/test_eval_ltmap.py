@@ -129,6 +129,12 @@ def test_viewframes_are_matched_through_times_and_sources():
     assert figures["reached"] and figures["viewframes_reached"] == 1.0
     assert not repeat_figures(taught, repeat, level, tolerance=0.05)["reached"]
     assert not repeat_figures(taught, {**repeat, "status": "FAILURE"}, level, tolerance=0.5)["reached"]
+    assert figures["bytes_per_m"] == pytest.approx(900 / 3.0)  # taught along 3 m
+    assert figures["estimates_pct"] is None  # a report without the counts
+    counted = repeat_figures(taught, {**repeat, "ltmap": {**repeat["ltmap"], "estimates": {
+        "zinf_1deg": 6, "zinf_4deg": 2, "compass": 1, "lost": 1}}}, level, tolerance=0.5)
+    assert counted["estimates_pct"] == {"zinf_1deg": 60.0, "zinf_2deg": 0.0, "zinf_4deg": 20.0, "zinf_8deg": 0.0,
+                                        "compass": 10.0, "no_rotation": 0.0, "lost": 10.0}
     assert repeat_figures(taught, None, level, tolerance=0.5) | {"reached": False} == {
         "cut": 1, "height": 1, "viewframes": 2, "landmarks": 40, "bytes": 900, "memory_fraction": 0.5,
         "status": "ERROR", "reached": False}
@@ -149,6 +155,10 @@ def test_the_evaluation_on_a_small_world_file(world_file, tmp_path, capsys):
     assert rows[0]["height"] == figures["teach.height"] and rows[-1]["height"] == 0
     assert figures["full.goal_reached"] == 1 and figures["full.path_error_m"] < 0.2  # the full tree leads home
     assert figures["full.viewframe_error_m"] < 0.6
+    shares = rows[0]["estimates_pct"]  # every estimate of the full tree's repeat counted by its rule
+    assert shares.keys() == {"zinf_1deg", "zinf_2deg", "zinf_4deg", "zinf_8deg", "compass", "no_rotation", "lost"}
+    assert sum(shares.values()) == pytest.approx(100.0)
+    assert rows[0]["bytes_per_m"] == pytest.approx(rows[0]["bytes"] / figures["teach.path_length_m"])
     assert all(r["map_as_expected"] for r in figures["runs"]) and "warning" not in figures
     assert len((out / "results.jsonl").read_text().splitlines()) == 1 + len(rows)  # a teach, a repeat per height
     assert list((out / "maps").iterdir())
@@ -156,7 +166,7 @@ def test_the_evaluation_on_a_small_world_file(world_file, tmp_path, capsys):
     assert main([*args, "--resume"]) == 0
     table = capsys.readouterr().out
     assert "small_room" in table and "goal reached by every seed down to" in table
-    assert len(table.splitlines()) == 4 + len(rows)
+    assert len(table.splitlines()) == 5 + len(rows)
     assert len((out / "results.jsonl").read_text().splitlines()) == 1 + len(rows)
     assert format_table(figures) == table.rstrip("\n")
 
