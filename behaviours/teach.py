@@ -11,7 +11,10 @@ saved: a file on disk is always a route that was driven to its end.
 
 The map is on ``/map/ltmap`` from the first viewframe on. The report's ``ltmap`` section holds
 the map's figures and, per viewframe, the tree time it was made (``taught``); an evaluation
-turns those times into places with the simulator's ground-truth trajectory.
+turns those times into places with the simulator's ground-truth trajectory. With gap filling
+(``gap_filling``, :mod:`maps.ltmap.gaps`) it also counts the landmarks found again and shifted
+to a common node (``shifted``) and lists the loops the route closed (``loops``: the viewframe
+pair, as taught, and the landmarks shared; ``loop_closures``: how many).
 """
 
 from __future__ import annotations
@@ -52,18 +55,23 @@ class LearnRoute(BearingsDecorator):
                        doc="memory budget, pruned online while teaching; 0: none")
     MIN_LANDMARKS = InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0, literal_only=True,
                               doc="pruning deletes viewframes left with fewer landmarks (the paper: 50)")
+    GAP_FILLING = InputPort("gap_filling", bool, True, literal_only=True,
+                            doc="landmarks found again are shifted to a common node; loops are reported")
     OBSERVATION = InputPort("observation", Observation, Ref("/perception/observation"), doc="the landmarks seen now")
-    PORTS = (PATH, THRESHOLD, BUDGET, MIN_LANDMARKS, OBSERVATION, ODOMETRY, LTMAP_OUT)
+    PORTS = (PATH, THRESHOLD, BUDGET, MIN_LANDMARKS, GAP_FILLING, OBSERVATION, ODOMETRY, LTMAP_OUT)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
         self.config = LearnConfig(threshold=self.get_input(self.THRESHOLD),
                                   budget_bytes=self.get_input(self.BUDGET) or None,
-                                  min_landmarks=self.get_input(self.MIN_LANDMARKS))
+                                  min_landmarks=self.get_input(self.MIN_LANDMARKS),
+                                  gap_filling=self.get_input(self.GAP_FILLING))
         self.learner = RouteLearner(self.config)
         self.taught: list[float] = []  # per viewframe, the tree time it was made
         self.places: list[list[float]] = []  # per viewframe, the odometry (x, y) it was made at (recording)
         self.prunes = 0
+        self.shifted = 0  # landmarks found again and merged into a common node (gap filling)
+        self.loops: list[dict[str, int | list[int]]] = []  # viewframe pairs where the route came back
         self.saved = False
         self._stamp: float | None = None
         self._logged = -1
@@ -71,6 +79,7 @@ class LearnRoute(BearingsDecorator):
     def initialise(self) -> None:
         self.learner = RouteLearner(self.config)
         self.taught, self.places, self.prunes, self.saved, self._stamp = [], [], 0, False, None
+        self.shifted, self.loops = 0, []
 
     def update(self) -> Status:
         self._learn()
@@ -93,6 +102,9 @@ class LearnRoute(BearingsDecorator):
         self._record(self.learner.observe(observation, pose.theta), pose)  # bearings compensated by the heading
 
     def _record(self, step: LearnStep, pose: Pose2D) -> None:
+        self.shifted += step.shifted
+        if step.loop is not None:
+            self.loops.append({"viewframes": [step.loop.earlier, step.loop.later], "shared": step.loop.shared})
         if step.pruned is not None and step.pruned.fits:
             self.prunes += 1
             kept: dict[int, int] = {}  # new viewframe -> the earliest old one it came from
@@ -135,7 +147,9 @@ class LearnRoute(BearingsDecorator):
             return
         taught = [{"viewframe": i, "time_s": t} for i, t in enumerate(self.taught)]
         yield from section("ltmap", {**summary_section(tree.summary()), "map_file": self.get_input(self.PATH),
-                                     "saved": self.saved, "online_prunes": self.prunes, "taught": taught})
+                                     "saved": self.saved, "online_prunes": self.prunes, "taught": taught,
+                                     "gap_filling": self.config.gap_filling, "shifted": self.shifted,
+                                     "loops": list(self.loops), "loop_closures": len(self.loops)})
 
     def drawings(self) -> Iterator[Drawing]:
         """The viewframes made so far, where odometry put them (when there are new ones)."""

@@ -60,7 +60,7 @@ from drivers.sim.simulation import path_distances
 from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
 from experiments.eval.figures import cell, mean_present
-from experiments.eval.ltmap_route import Route, default_route, given_route, parse_route
+from experiments.eval.ltmap_route import Route, back_route, default_route, given_route, parse_route
 from experiments.eval.ltmap_table import estimate_shares, memory_limits, row_figures
 from experiments.eval.ltmap_table import format_table as format_table  # the area's table (experiments.eval)
 from experiments.eval.trajectory import TrueTrajectory
@@ -74,8 +74,9 @@ DESCRIPTION = "teach and repeat: viewframe and path error, goal reached per LT-m
 OPTIONS = {
     "camera": "the camera the missions read: panorama (rendered images, ORB; default) or landmarks (ideal bearings); "
               "any panorama or bearings camera of the world",
-    "route": "the taught waypoints x0,y0,x1,y1,... (m, odometry frame of the world's start pose); "
-             "default: a tour of the free floor",
+    "route": "tour (default: a tour of the free floor), back (out along the tour and back past its bend: a route "
+             "that revisits places) or the taught waypoints x0,y0,x1,y1,... (m, odometry frame of the start pose)",
+    "gap_filling": "on (default) or off: the teach shifts landmarks found again to a common node (maps.ltmap.gaps)",
     "min_landmarks": "pruning deletes viewframes left with fewer landmarks (default: 50, or half the median "
                      "viewframe of a map with small viewframes)",
     "goal_tolerance": "m: the goal is reached when the repeat succeeds and ends this close to the route's start "
@@ -85,6 +86,8 @@ OPTIONS = {
 }
 ROTATIONS = ("zinf", "compass")
 TEACH, FOLLOW = "teach_route", "follow_route"
+TOUR, BACK = "tour", "back"
+ON_OFF = {"on": True, "off": False}
 CAMERA_KINDS = ("panorama", "bearings")
 SMALL_VIEWFRAME = 2 * DEFAULT_MIN_LANDMARKS  # landmarks: below this, min_landmarks is half the median viewframe
 REPEAT_TIME = (120.0, 4.0)  # s: a repeat's --max-time = a + b * the teach's sim time
@@ -100,6 +103,7 @@ class Settings:
     min_landmarks: int | None  # None: from the map (module docstring)
     goal_tolerance: float | None  # m; None: per seed from the robot and the map (module docstring)
     rotation: str = "zinf"  # FollowRoute's rotation estimate (ROTATIONS)
+    gap_filling: bool = True  # LearnRoute's gap filling (maps.ltmap.gaps)
 
 
 def check_world(world: str) -> World:
@@ -119,7 +123,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
         usable = ", ".join(n for n, k in kinds.items() if k in CAMERA_KINDS) or "none"
         raise ValueError(f"camera: {camera!r} is not a panorama or bearings camera of world {loaded.name!r} "
                          f"(usable: {usable})")
-    route = given_route(loaded, parse_route(extra["route"])) if "route" in extra else default_route(loaded)
+    route = _route(loaded, extra.get("route", TOUR))
     min_landmarks = None
     if "min_landmarks" in extra:
         min_landmarks = _number(extra["min_landmarks"], "min_landmarks", int)
@@ -133,7 +137,19 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     rotation = extra.get("rotation", "zinf")
     if rotation not in ROTATIONS:
         raise ValueError(f"rotation must be one of {', '.join(ROTATIONS)}, got {rotation!r}")
-    return Settings(camera, route, min_landmarks, tolerance, rotation)
+    gap_filling = extra.get("gap_filling", "on")
+    if gap_filling not in ON_OFF:
+        raise ValueError(f"gap_filling must be on or off, got {gap_filling!r}")
+    return Settings(camera, route, min_landmarks, tolerance, rotation, ON_OFF[gap_filling])
+
+
+def _route(world: World, text: str) -> Route:
+    """The route an option names: the tour, out and back along it, or given waypoints."""
+    if text == TOUR:
+        return default_route(world)
+    if text == BACK:
+        return back_route(world)
+    return given_route(world, parse_route(text))
 
 
 def _number(text: str, name: str, kind: type[int] | type[float]) -> Any:
@@ -188,9 +204,12 @@ def levels(tree: LandmarkTree, min_landmarks: int) -> list[Level]:
 
 
 def teach_episode(world: str, seed: int, settings: Settings, folder: Path, max_time_s: float | None) -> Episode:
-    path = folder / MAPS / f"{Path(world).stem}_s{seed:04d}.ltmap"
+    path = folder / MAPS / f"{Path(world).stem}{'' if settings.gap_filling else '_nogaps'}_s{seed:04d}.ltmap"
     route = [round(v, 3) for v in settings.route.odometry]
-    return Episode(TEACH, world, seed, {"map": str(path), "camera": settings.camera, "route": route}, max_time_s)
+    inputs: dict[str, Any] = {"map": str(path), "camera": settings.camera, "route": route}
+    if not settings.gap_filling:  # only when not the default: the ids of the default's results stay
+        inputs["gap_filling"] = False
+    return Episode(TEACH, world, seed, inputs, max_time_s)
 
 
 def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_landmarks: int,
@@ -332,6 +351,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
                            "height": tree.height, "bytes": tree.memory_bytes(), "min_landmarks": minimum,
                            "goal_tolerance_m": tolerance[seed],
                            "path_length_m": report["ground_truth"]["trajectory_length_m"],
+                           "shifted": report.get("ltmap", {}).get("shifted"),
+                           "loop_closures": report.get("ltmap", {}).get("loop_closures"),
                            "sim_time_s": report.get("sim_time_s")})
         plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation), taught, level)
                  for level in levels(tree, minimum)]
@@ -373,6 +394,9 @@ def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dic
         "teach.height": mean_present([t["height"] for t in teach_rows]),
         "teach.bytes": mean_present([t["bytes"] for t in teach_rows]),
         "teach.path_length_m": mean_present([t["path_length_m"] for t in teach_rows]),
+        "gap_filling": settings.gap_filling,
+        "teach.shifted": mean_present([t.get("shifted") for t in teach_rows]),
+        "teach.loop_closures": mean_present([t.get("loop_closures") for t in teach_rows]),
         "min_landmarks": sorted({t["min_landmarks"] for t in teach_rows}),
         "repeats": len(runs),
     }

@@ -20,6 +20,11 @@ RULE_COLUMNS = {"zinf_1deg": "z1", "zinf_2deg": "z2", "zinf_4deg": "z4", "zinf_8
                 "no_rotation": "none", "lost": "lost"}
 
 
+def _per_metre(figures: Mapping[str, Any]) -> float | None:
+    rows = figures.get("rows") or []
+    return rows[0].get("bytes_per_m") if rows else None
+
+
 def estimate_shares(counts: Mapping[str, int]) -> dict[str, float] | None:
     """Per rule (:data:`behaviours.route.ESTIMATE_RULES`) its percentage of a repeat's estimates
     (None: the repeat made none, or its report predates the counts)."""
@@ -82,6 +87,10 @@ def format_table(figures: Mapping[str, Any]) -> str:
         f"rotation {figures.get('rotation', 'zinf')}, route: {route}, taught {figures['taught']}/{figures['seeds']}",
         f"goal reached: {figures['criterion']}; min_landmarks {figures['min_landmarks']}; path error of the repeats "
         "that reached the goal (of all repeats)",
+        f"gap filling {'on' if figures.get('gap_filling', True) else 'off'}: "
+        f"{cell(figures.get('teach.shifted'), 1)} landmarks shifted to a common node and "
+        f"{cell(figures.get('teach.loop_closures'), 1)} loops closed per teach; "
+        f"{cell(_per_metre(figures), 0)} B per metre of route (full tree)",
         "estimates % by rule: z1..z8 Z-infinity's far threshold 1..8 deg, cmp the compass, none no rotation, "
         "lost too few matches",
         f"{'height':>6} {'cut':>3} {'viewframes':>10} {'landmarks':>9} {'memory %':>8} {'B/m':>6} {'vf err m':>8} "

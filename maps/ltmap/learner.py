@@ -30,6 +30,10 @@ with the camera's heading; it decides where viewframes are and hands the tree
   bearing stays within ``share_angle`` of the stored one; by default the angle whose eq. 1 cost
   equals the threshold (:func:`threshold_angle`, 3 deg by default), so that at a viewframe's own
   place ``delta_t`` stays under the threshold and route following can switch there.
+- **Gap filling** (``gap_filling``, on by default): after each new viewframe its landmarks are
+  looked for among the map's other rows; one found again within ``share_angle`` is shifted to
+  the common node of its two copies, and a route back past an earlier place is reported as a
+  loop (:mod:`maps.ltmap.gaps` says how the paper is read there).
 - **Online pruning.** With a memory budget the map is pruned whenever it outgrows it
   (:mod:`maps.ltmap.prune`), so the route's length need not be known in advance.
 """
@@ -42,6 +46,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from maps.ltmap.arrays import IDS
+from maps.ltmap.gaps import DEFAULT_GAPS, GapConfig, GapFill, Loop
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS, PruneReport
 from maps.ltmap.tree import LandmarkSet, LandmarkTree
 from perception.matching import LandmarkMatches, match_features
@@ -62,7 +67,8 @@ class LearnConfig:
     ``scale``) and eq. 1's ``scale`` ``b``, the ``share_angle`` (rad) within which a tracked
     landmark keeps its stored bearing and is shared (None: the angle whose eq. 1 cost is the
     threshold), the matching ``ratio`` (None: the kind's default), an optional memory budget
-    (bytes, pruned online) and the smallest viewframe pruning keeps."""
+    (bytes, pruned online), the smallest viewframe pruning keeps, and whether landmarks found
+    again are shifted to a common node (``gap_filling``, with ``gaps``: :mod:`maps.ltmap.gaps`)."""
 
     threshold: float | None = None
     scale: float = DEFAULT_SCALE
@@ -70,6 +76,8 @@ class LearnConfig:
     ratio: float | None = None
     budget_bytes: int | None = None
     min_landmarks: int = DEFAULT_MIN_LANDMARKS
+    gap_filling: bool = True
+    gaps: GapConfig = DEFAULT_GAPS
 
     def __post_init__(self) -> None:
         for name in ("threshold", "scale", "share_angle"):
@@ -101,7 +109,8 @@ class LearnStep:
     there was none); ``tracked``: landmarks of the previous viewframe seen now; ``stored``:
     landmarks stored in the new leaf (new ones and sightings not shared); ``volatile``: features
     rejected because the previous image lacked them; ``pruned``: the online pruning this step
-    ran (a budget is set and was exceeded).
+    ran (a budget is set and was exceeded); ``shifted``: landmarks found again and merged into a
+    common node (gap filling); ``loop``: the loop this viewframe closed.
     """
 
     viewframe: int
@@ -111,6 +120,8 @@ class LearnStep:
     stored: int = 0
     volatile: int = 0
     pruned: PruneReport | None = None
+    shifted: int = 0
+    loop: Loop | None = None
 
     @property
     def over_budget(self) -> bool:
@@ -226,8 +237,20 @@ class RouteLearner:
         stored = np.arange(before, tree.landmark_count)
         self._anchor = _Anchor(np.concatenate((landmarks, stored)),
                                np.vstack((sightings.bearings, tree.bearings[stored])))
+        filled = self._fill_gaps(tree)
+        stored_now = len(tree.node_landmarks(tree.viewframe_leaves[-1]))  # gap filling may have merged some away
         pruned = self._prune_online(tree)
-        return LearnStep(tree.viewframe_count - 1, True, float(change), count, len(stored), volatile, pruned)
+        return LearnStep(tree.viewframe_count - 1, True, float(change), count, stored_now, volatile, pruned,
+                         filled.shifted if filled else 0, filled.loop if filled else None)
+
+    def _fill_gaps(self, tree: LandmarkTree) -> GapFill | None:
+        if not self.config.gap_filling:
+            return None
+        filled = tree.fill_gaps(self.share_angle, self.config.gaps, ratio=self.config.ratio)
+        if filled.shifted:  # the anchor follows: a deleted copy is its kept twin now (once)
+            landmarks, first = np.unique(filled.landmark_index[self._anchor.landmarks], return_index=True)
+            self._anchor = _Anchor(landmarks, self._anchor.bearings[first])
+        return filled
 
     def _prune_online(self, tree: LandmarkTree) -> PruneReport | None:
         budget = self.config.budget_bytes

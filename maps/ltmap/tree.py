@@ -40,6 +40,10 @@ short-lived local ones near the leaves. Pure: numpy arrays and dataclasses, no I
   that tracked it. On a synthetic corridor (tests, benchmark) over 99% of a viewframe's
   landmarks are visible from it within 5 deg of their stored bearing, for 5-10% more memory
   than moving every tracked landmark up (which leaves about a third of them wrong).
+- **Gap filling** (:meth:`LandmarkTree.fill_gaps`, :mod:`maps.ltmap.gaps`): a landmark stored
+  twice within ``share_angle`` (it dropped out of tracking and was stored again) becomes one, in
+  the common node of its two copies, when that node gives it only to a short gap of viewframes
+  between its sightings. With it, a viewframe may hold a landmark it did not see in that gap.
 - **Memory** (:meth:`LandmarkTree.memory_bytes`) is exactly what :meth:`LandmarkTree.to_arrays`
   holds (:mod:`maps.ltmap.arrays`).
 """
@@ -65,6 +69,7 @@ from maps.ltmap.arrays import (
     preorder,
     readonly,
 )
+from maps.ltmap.gaps import DEFAULT_GAPS, GapConfig, GapFill, found_again, plan_shifts
 from maps.ltmap.matching import Viewframe, ViewframeCache, match_viewframe, stack_viewframe
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS, PruneReport, PruneStep, cut_lowest_level, follow
 from perception.matching import LandmarkMatches
@@ -145,6 +150,19 @@ def attach_level(lost: np.ndarray, tracked: np.ndarray, leaves: np.ndarray) -> i
     stored_again = (below & (leaves[None, :] < shared_cover(leaves)[:, None])) @ tracked
     cost = stale + stored_again
     return int(len(cost) - 1 - np.argmin(cost[::-1]))
+
+
+def _resolve(index: np.ndarray, alive: np.ndarray) -> np.ndarray:
+    """``index`` holds, for a deleted row, the OLD row it merged into (which may be deleted too):
+    follow to a surviving row and give its new index."""
+    renumbered = np.where(alive, np.cumsum(alive) - 1, -1)
+    out = renumbered.copy()
+    for row in np.flatnonzero(~alive).tolist():
+        target = int(index[row])
+        while not alive[target]:
+            target = int(index[target])
+        out[row] = renumbered[target]
+    return out
 
 
 @dataclass
@@ -334,6 +352,27 @@ class LandmarkTree:
         self._leaves.append(leaf)
         self._cache.clear()
         return len(self._leaves) - 1
+
+    def fill_gaps(self, share_angle: float, config: GapConfig = DEFAULT_GAPS, *,
+                  ratio: float | None = None) -> GapFill:
+        """Find the last viewframe's landmarks again among the map's other rows and shift each found
+        within ``share_angle`` to the common node of its two copies (:mod:`maps.ltmap.gaps`)."""
+        if not self._leaves:
+            return GapFill(0, 0, None, np.arange(0))
+        candidates = np.flatnonzero(np.isin(self._rows.node, self.branch_nodes(-1)))
+        pairs = found_again(self.kind, self._rows.data, self._rows.bearings, candidates, share_angle, ratio=ratio)
+        plan = plan_shifts(self._parent, self._leaves, self._rows.node, pairs, config)
+        index = np.arange(self.landmark_count)
+        if len(plan.drop):
+            self._rows.node[plan.keep] = plan.node
+            alive = np.ones(self.landmark_count, dtype=bool)
+            alive[plan.drop] = False
+            merged_into = np.arange(self.landmark_count)
+            merged_into[plan.drop] = plan.keep  # a kept row may itself merge later in the batch: _resolve follows
+            index = _resolve(merged_into, alive)
+            self._rows = self._rows.take(alive)
+            self._cache.clear()
+        return GapFill(len(pairs), len(plan.drop), plan.loop, index)
 
     def _check_rows(self, new: LandmarkSet) -> None:
         data = new.ids if self.kind == IDS else new.descriptors
