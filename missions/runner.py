@@ -24,6 +24,15 @@ SIGINT / SIGTERM           INTERRUPTED  130 / 143, even while a behaviour blocks
 In every case the base and the pan-tilt unit are commanded to stop before any driver closes,
 and the last command recorded (report and recording) is a zero velocity.
 
+The collision monitor sits between the tree and the base on every run: the runner wraps
+``robot.base`` in a :class:`~drivers.safety.guarded_base.GuardedBase` before the tree is set up,
+so every command (the tree's, or a node's own call to the base) is limited against the robot's
+range source (``robot.ranges``) with the footprint and zones of ``safety`` (a
+:class:`~perception.collision_monitor.MonitorConfig`; default: a Pioneer 3-DX's). After each
+tick ``/robot/safety`` holds the monitor's state, the recording gets an event line per
+intervention, and the report a ``safety`` section (stops and slow-downs counted as episodes,
+bumper hits, the nearest range, the first events).
+
 Capabilities add to the report and the recording without touching the runner: any node of the
 tree may report ``figures()`` (named values, gathered into the report's sections: ``ltmap``,
 ``roadmap``, ``exploration``; numbers are plotted in the recording too) and ``drawings()``
@@ -37,6 +46,7 @@ used, and where they came from). Behaviours still never see ground truth: the si
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 import sys
 import time
@@ -50,16 +60,20 @@ import py_trees
 from py_trees.common import Status
 
 from behaviours.clock import TickClock
-from behaviours.keys import COMMAND_KEYS, input_key
-from behaviours.telemetry import Draws, Reports, Sections
+from behaviours.keys import COMMAND_KEYS, SAFETY_KEY, input_key
+from behaviours.telemetry import Draws, Event, Plot, Reports, Sections
 from drivers.interfaces import STOP, KeyboardOpener, PanTiltCommand, Robot, VelocityCommand
 from drivers.keyboard import TerminalKeys
+from drivers.pioneer_body import BODIES
+from drivers.safety.guarded_base import GuardedBase
+from drivers.safety.settings import monitor_config
 from maps.store import write_json
 from missions.builder import build_root
 from missions.clocks import WallClock
 from missions.language import MissionSpec
 from missions.recording import Recorder
 from missions.safety import Interrupted, SafetyMonitor, exit_code
+from perception.collision_monitor import CollisionMonitor, MonitorConfig
 
 
 class RunObserver(Protocol):
@@ -115,12 +129,15 @@ class Runner:
         observers: Sequence[RunObserver] = (),
         on_tick: Callable[[Runner], None] | None = None,
         keyboard: KeyboardOpener = TerminalKeys,
+        safety: MonitorConfig | None = None,
     ) -> None:
         self.mission = mission
-        self.robot = robot
         self.keyboard = keyboard  # opened by a node that drives by keys, when it first runs
         self.options = options or RunOptions()
         self.clock: TickClock = clock or WallClock()
+        config = safety or monitor_config(None, BODIES["p3dx"].footprint)
+        self.guard = GuardedBase(robot.base, CollisionMonitor(config), robot.ranges, self.clock.now)
+        self.robot = dataclasses.replace(robot, base=self.guard)  # the tree and the stops see the guarded base
         self.observers = tuple(observers)
         self.on_tick = on_tick
         self.rate_hz = self.options.rate_hz or mission.rate_hz
@@ -137,7 +154,7 @@ class Runner:
         self.tree.add_pre_tick_handler(self._clear_commands)
         self.tree.add_post_tick_handler(self._dispatch)
         self.blackboard = py_trees.blackboard.Client(name="runner")
-        for spec in COMMAND_KEYS:
+        for spec in (*COMMAND_KEYS, SAFETY_KEY):
             self.blackboard.register_key(key=spec.path, access=py_trees.common.Access.WRITE)
         overrun = self.options.overrun_s
         if overrun is None and self.clock.timeline == "wall_time":
@@ -180,6 +197,7 @@ class Runner:
                                       timeline=self.clock.timeline)
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
+        self.blackboard.set(SAFETY_KEY.path, self.guard.state)
         # hand every node the clock and the drivers (the keyboard as an opener: a terminal is taken only if used)
         self.tree.setup(clock=self.clock, robot=self.robot, keyboard=self.keyboard)
         self._drawers = [node for node in self.root.iterate() if isinstance(node, Reports | Draws)]
@@ -227,7 +245,11 @@ class Runner:
         result = RunResult(status, reason, self.ticks, self.clock.now(), signum=self.monitor.signum)
         result.report = self._report(result)
         if self.options.report_path is not None:
-            write_json(self.options.report_path, result.report)
+            try:
+                write_json(self.options.report_path, result.report)
+            except OSError as exc:  # a full disk must not turn the run's outcome into a traceback
+                sys.stderr.write(f"bearings run: the report was not written to {self.options.report_path}: "
+                                 f"{exc.strerror or exc}; the run ended {status} ({reason})\n")
         return result
 
     def _emergency_exit(self, signum: int) -> None:
@@ -251,8 +273,10 @@ class Runner:
         if self.monitor.stopped_reason is not None:
             return  # the monitor stopped the base: the tree's command must not restart it
         command = self._get("/robot/command")
-        self.last_command = command if isinstance(command, VelocityCommand) else STOP
-        self.robot.base.drive(self.last_command.v, self.last_command.w)
+        asked = command if isinstance(command, VelocityCommand) else STOP
+        self.robot.base.drive(asked.v, asked.w)  # through the collision monitor
+        self.last_command = VelocityCommand(asked.v * self.guard.state.ratio, asked.w * self.guard.state.ratio)
+        self.blackboard.set(SAFETY_KEY.path, self.guard.state)
         ptu_command = self._get("/ptu/command")
         if self.robot.ptu is not None and isinstance(ptu_command, PanTiltCommand) and ptu_command != self._last_ptu:
             self.robot.ptu.move(ptu_command.pan, ptu_command.tilt, ptu_command.speed)
@@ -261,6 +285,9 @@ class Runner:
             self._recorder.log_tick(time_s=self.clock.now(), tick=self.ticks + 1, root=self.root,
                                     odometry=self._get("/robot/odometry"), command=self.last_command,
                                     observers=self.observers, nodes=self._drawers)
+            self._recorder.draw(Plot("safety/ratio", self.guard.state.ratio))
+            for event in self.guard.log.take_new():
+                self._recorder.draw(Event("safety/events", event.line()))
 
     # -- helpers ---------------------------------------------------------------------------------
     def _get(self, key: str) -> Any:
@@ -318,7 +345,8 @@ class Runner:
             report.update(observer.report_sections(mission.evaluation))
         for name, values in self._node_sections().items():
             report.setdefault(name, {}).update(values)
-        for device in (self.robot.base, self.robot.ptu):
+        report["safety"] = self.guard.log.summary()
+        for device in (self.guard.base, self.robot.ptu):
             sections = getattr(device, "report_sections", None)
             if callable(sections):
                 report.update(sections())

@@ -2,9 +2,10 @@
 
 The simulation calls :meth:`RerunLogger.log` once per recorded tick, handing itself in as the
 :class:`Simulated` it is (this module does not know the simulation, only what it reads of it).
-The world is logged once (static); poses are two points per tick; the trajectories are re-logged
-as line strips only every ``trail_every`` ticks (decimated), and camera images only every
-``image_every`` ticks and only when the camera grabbed a new frame: logging never renders.
+The world is logged once (static); poses are two points per tick, the people (they move) a point
+each; the trajectories are re-logged as line strips only every ``trail_every`` ticks (decimated),
+and camera images only every ``image_every`` ticks and only when the camera grabbed a new frame:
+logging never renders.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ WALL_COLOUR = (200, 200, 200)
 TRUE_COLOUR = (60, 200, 60)
 ODOM_COLOUR = (230, 120, 40)
 LANDMARK_COLOUR = (80, 140, 255)
+PERSON_COLOUR = (230, 60, 160)
 
 
 class Simulated(Protocol):
@@ -47,6 +49,8 @@ class Simulated(Protocol):
 
     def odometry_trajectory_in_world(self) -> np.ndarray: ...
 
+    def people_xy(self) -> np.ndarray: ...
+
 
 class RerunLogger:
     """Per-simulation rerun logging state (what was logged already, tick counter)."""
@@ -66,25 +70,7 @@ class RerunLogger:
         if not self._world_logged:
             self._log_world(sim, rec, rr)
             self._world_logged = True
-        true, odom = sim.true_pose(), sim.odometry_in_world()
-        rec.log("world/ground_truth/robot", rr.Points2D([[true.x, true.y]], radii=0.1, colors=[TRUE_COLOUR]))
-        rec.log("world/ground_truth/odometry", rr.Points2D([[odom[0], odom[1]]], radii=0.06, colors=[ODOM_COLOUR]))
-        heading = [[0.4 * math.cos(true.theta), 0.4 * math.sin(true.theta)]]
-        rec.log(
-            "world/ground_truth/heading", rr.Arrows2D(vectors=heading, origins=[[true.x, true.y]], colors=[TRUE_COLOUR])
-        )
-        if sim.ptu is not None:
-            state = sim.ptu.state()
-            direction = true.theta + state.pan
-            reach = 1.5 * math.cos(state.tilt)
-            rec.log(
-                "world/ground_truth/ptu_view",
-                rr.Arrows2D(
-                    vectors=[[reach * math.cos(direction), reach * math.sin(direction)]],
-                    origins=[[true.x, true.y]],
-                    colors=[(255, 220, 0)],
-                ),
-            )
+        self._log_poses(sim, rec, rr)
         if self._ticks % self.trail_every == 0:
             for name, rows, colour in (
                 ("true", sim.true_trajectory(), TRUE_COLOUR),
@@ -103,6 +89,32 @@ class RerunLogger:
                 if frame.right is not None:
                     rec.log(f"camera/{name}_right", rr.Image(frame.right))
         self._ticks += 1
+
+    @staticmethod
+    def _log_poses(sim: Simulated, rec: Any, rr: Any) -> None:
+        """The true and odometry poses, the heading, the people and the pan-tilt view direction."""
+        true, odom = sim.true_pose(), sim.odometry_in_world()
+        rec.log("world/ground_truth/robot", rr.Points2D([[true.x, true.y]], radii=0.1, colors=[TRUE_COLOUR]))
+        rec.log("world/ground_truth/odometry", rr.Points2D([[odom[0], odom[1]]], radii=0.06, colors=[ODOM_COLOUR]))
+        heading = [[0.4 * math.cos(true.theta), 0.4 * math.sin(true.theta)]]
+        rec.log(
+            "world/ground_truth/heading", rr.Arrows2D(vectors=heading, origins=[[true.x, true.y]], colors=[TRUE_COLOUR])
+        )
+        if sim.world.people:
+            radii = [person.radius for person in sim.world.people]
+            rec.log("world/people", rr.Points2D(sim.people_xy(), radii=radii, colors=[PERSON_COLOUR]))
+        if sim.ptu is not None:
+            state = sim.ptu.state()
+            direction = true.theta + state.pan
+            reach = 1.5 * math.cos(state.tilt)
+            rec.log(
+                "world/ground_truth/ptu_view",
+                rr.Arrows2D(
+                    vectors=[[reach * math.cos(direction), reach * math.sin(direction)]],
+                    origins=[[true.x, true.y]],
+                    colors=[(255, 220, 0)],
+                ),
+            )
 
     @staticmethod
     def _log_world(sim: Simulated, rec: Any, rr: Any) -> None:

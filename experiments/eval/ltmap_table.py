@@ -14,7 +14,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from behaviours.route import ESTIMATE_RULES
-from experiments.eval.figures import cell, mean_present
+from experiments.eval import people as crowd
+from experiments.eval.figures import cell, mean_present, safety_cells, safety_totals
 
 RULE_COLUMNS = {"zinf_1deg": "z1", "zinf_2deg": "z2", "zinf_4deg": "z4", "zinf_8deg": "z8", "compass": "cmp",
                 "no_rotation": "none", "lost": "lost"}
@@ -57,6 +58,7 @@ def row_figures(runs: list[dict[str, Any]]) -> dict[str, Any]:
                           for rule in ESTIMATE_RULES},
         "recoveries": mean_present([r.get("recoveries") for r in good]),
         "sim_time_s": mean_present([r.get("sim_time_s") for r in good]),
+        **safety_totals(good),
     }
     if len(good) < len(runs):
         row["errors"] = len(runs) - len(good)
@@ -95,7 +97,7 @@ def format_table(figures: Mapping[str, Any]) -> str:
         "lost too few matches",
         f"{'height':>6} {'cut':>3} {'viewframes':>10} {'landmarks':>9} {'memory %':>8} {'B/m':>6} {'vf err m':>8} "
         f"{'path err m':>16} {'goal err m':>10} {'vf reached %':>12} {'goal reached':>12} "
-        + " ".join(f"{name:>4}" for name in RULE_COLUMNS.values()),
+        + " ".join(f"{name:>4}" for name in RULE_COLUMNS.values()) + "  obstacles",
     ]
     for row in figures["rows"]:
         low, high = row["height_range"]
@@ -108,11 +110,13 @@ def format_table(figures: Mapping[str, Any]) -> str:
                      f"{cell(row['viewframe_error_m']):>8} {path:>16} {cell(row['goal_error_m']):>10} "
                      f"{cell(row['viewframes_reached_pct'], 0):>12} {row['goal_reached']:>7} of {row['seeds']:<3} "
                      + " ".join(f"{cell(shares.get(rule), 0):>4}" for rule in RULE_COLUMNS)
-                     + (f"  ({row['errors']} errors)" if row.get("errors") else ""))
+                     + f"  {safety_cells(row)}" + (f"  ({row['errors']} errors)" if row.get("errors") else ""))
     still, lost = figures.get("goal_reached_down_to_memory_pct"), figures.get("goal_first_missed_memory_pct")
     if figures["rows"]:
         lines.append(f"goal reached by every seed down to {cell(still, 1)} % memory; first missed at "
                      f"{cell(lost, 1)} %")
+    lines.append(f"teaching: {safety_cells({k[6:]: v for k, v in figures.items() if k.startswith('teach.')})}")
+    lines += crowd.table_line(figures)
     for fail in figures["teach_failed"]:
         lines.append(f"seed {fail['seed']}: no map to repeat ({fail['problem']})")
     if figures.get("warning"):

@@ -9,20 +9,29 @@ from typing import Any
 
 from behaviours.clock import TickClock
 from drivers.interfaces import Robot
+from drivers.safety.settings import monitor_config
 from maps.located import validate
 from maps.store import Diagnostic, InputError, output_problem, write_json
 from missions.clocks import Paced, WallClock
 from missions.commands.common import add_mission_options, load_from_args, parse_pose, print_input_error
 from missions.model import RunArguments
+from missions.outputs import prepare_written_files
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
+from perception.collision_monitor import MonitorConfig
 from perception.geometry import Pose2D
+from perception.polygons import disc
 
 DESCRIPTION = """Run a mission until its tree ends in SUCCESS or FAILURE.
 
 Without --robot the mission runs in the built-in simulator (--sim WORLD picks a shipped world by
 name or a world file; the default is an empty plane), as fast as the machine allows unless
 --realtime is given. The same seed gives the same run, bit for bit.
+
+Every command passes the collision monitor on its way to the base: it stops the robot short of
+what its range sensors see, slows it near obstacles, and crawls when they fall silent (the
+robot profile's safety: section; in the simulator, zones around the world's robot disc). The
+report's safety section and the last lines printed count its stops.
 
 Whatever happens (the tree ends, a behaviour raises or blocks, Ctrl-C, SIGTERM, --max-time), the
 base and the pan-tilt unit are commanded to stop before the drivers close, and --report is
@@ -66,18 +75,22 @@ def run(args: argparse.Namespace) -> int:
             numbers = _numbers(args)
             _prepare_outputs(args)
             mission = load_from_args(args.mission, args)
-            simulation, robot, clock = _open(args, numbers.seed)
+            prepare_written_files(mission, lambda note: print(f"bearings run: {note}", file=sys.stderr))
+            simulation, robot, clock, safety = _open(args, numbers.seed)
         except InputError as exc:
             return print_input_error(exc)
+        except DeviceUnavailable as exc:
+            return _device_fault(args, exc)
         except Interrupted as exc:
             return _interrupted_early(args, exc.signum)
         try:
-            return _run(args, mission, (simulation, robot, clock), numbers)
+            return _run(args, mission, (simulation, robot, clock), numbers, safety)
         finally:
             robot.close()
 
 
-def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickClock], numbers: RunArguments) -> int:
+def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickClock], numbers: RunArguments,
+         safety: MonitorConfig) -> int:
     simulation, robot, clock = opened
     missing = robot.missing_cameras(mission.cameras or ())
     if missing:
@@ -91,20 +104,36 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
     )  # fmt: skip
     if args.realtime and simulation is not None:
         clock = Paced(clock)
-    result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else []).run()
+    result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
+                    safety=safety).run()
     clock_name = "sim" if simulation is not None else "wall"
     print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock_name} time, {result.ticks} ticks "
           f"({result.reason})")
-    gt = result.report.get("ground_truth")
-    if gt:
-        figures = ", ".join(f"{k} {gt[k]:.3f}" for k in ("trajectory_length_m", "goal_error_m", "path_error_m")
-                            if k in gt)
-        print(f"ground truth: {figures}")
+    for line in outcome_lines(result.report):
+        print(line)
     if args.report:
         print(f"report: {args.report}")
     if args.save:
         print(f"recording: {args.save} (open with: rerun {args.save})")
     return result.exit_code
+
+
+def outcome_lines(report: dict[str, Any]) -> list[str]:
+    """The lines after the status: the collision monitor's count, and the ground truth in simulation
+    (collisions and the true minimum clearance first: a run that touched something did not succeed)."""
+    safety = report.get("safety", {})
+    nearest = safety.get("min_range_m")
+    lines = [f"safety: {safety.get('safety_stops', 0)} stops, {safety.get('slowdowns', 0)} slow-downs, "
+             f"{safety.get('bumper_hits', 0)} bumper hits, nearest sensed "
+             f"{'nothing' if nearest is None else f'{nearest:.3f} m'} (sensors: {safety.get('sources', 'none')})"]
+    gt = report.get("ground_truth")
+    if gt:
+        figures = [f"collisions {gt.get('collisions', 0)}"]
+        if gt.get("min_clearance_m") is not None:
+            figures.append(f"min_clearance_m {gt['min_clearance_m']:.3f}")
+        figures += [f"{k} {gt[k]:.3f}" for k in ("trajectory_length_m", "goal_error_m", "path_error_m") if k in gt]
+        lines.append(f"ground truth: {', '.join(figures)}")
+    return lines
 
 
 def _numbers(args: argparse.Namespace) -> RunArguments:
@@ -129,6 +158,20 @@ def _prepare_outputs(args: argparse.Namespace) -> None:
         raise InputError(problems)
 
 
+class DeviceUnavailable(Exception):  # noqa: N818 - a state of the robot, as DriverFault
+    """A device of the robot could not be opened or did not answer: a fault of the machine, not of
+    the input (exit 1 with a report, as ``doctor`` says 1), the profile itself being valid."""
+
+
+def _device_fault(args: argparse.Namespace, exc: DeviceUnavailable) -> int:
+    reason = f"device fault: {exc}"
+    print(f"{args.mission}: FAILURE ({reason})", file=sys.stderr)
+    if args.report and not output_problem(args.report):
+        write_json(args.report, {"mission": str(args.mission), "status": "FAILURE", "reason": reason,
+                                 "ticks": 0, "wall_time_s": 0.0, "last_command": {"v": 0.0, "w": 0.0}})
+    return 1
+
+
 def _interrupted_early(args: argparse.Namespace, signum: int) -> int:
     reason = "interrupted before the mission started"
     print(f"{args.mission}: INTERRUPTED ({reason})", file=sys.stderr)
@@ -138,19 +181,24 @@ def _interrupted_early(args: argparse.Namespace, signum: int) -> int:
     return exit_code(signum)
 
 
-def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock]:
-    """(simulation or None, robot, the clock the run ticks on)."""
+def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock, MonitorConfig]:
+    """(simulation or None, robot, the clock the run ticks on, the collision monitor's configuration)."""
     if args.robot:
-        from missions.profiles import open_robot
+        from missions.profiles import open_robot, robot_safety
 
         if args.start:
             raise InputError([Diagnostic("--start", 0, 0, "sets the simulated robot's start; a real robot starts "
                                          "where it stands")])
         clock = WallClock()  # one time axis for the drivers' stamps and the tree
         try:
-            return None, open_robot(args.robot, clock=clock.now), clock
-        except OSError as exc:
-            raise InputError([Diagnostic(args.robot, 0, 0, f"cannot open the robot: {exc}")]) from None
+            robot = open_robot(args.robot, clock=clock.now)
+        except OSError as exc:  # a valid profile whose robot does not answer: a device fault, not bad input
+            raise DeviceUnavailable(f"cannot open the robot of {args.robot}: {exc}") from None
+        try:
+            return None, robot, clock, robot_safety(args.robot, robot)
+        except InputError:
+            robot.close()
+            raise
     from drivers.sim.simulation import Simulation
     from drivers.sim.world import load_world
 
@@ -159,7 +207,7 @@ def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock]:
     except (OSError, ValueError) as exc:  # InputError (a bad world file) passes through as it is
         raise InputError([Diagnostic(str(args.sim), 0, 0, str(exc))]) from None
     simulation = Simulation(world, seed=seed, start=_start_pose(args.start, world))
-    return simulation, simulation.robot, simulation.clock()
+    return simulation, simulation.robot, simulation.clock(), monitor_config(None, disc(world.robot_radius))
 
 
 def _start_pose(text: str | None, world: Any) -> Pose2D | None:

@@ -183,9 +183,10 @@ def test_every_setting_is_documented():
     from drivers.cameras import HttpCameraSettings, OpenCVCameraSettings
     from drivers.pioneer import PioneerSettings
     from drivers.ptu_d46 import PtuD46Settings
+    from drivers.safety.settings import SafetySettings
 
     page = (Path(__file__).resolve().parents[2] / "docs" / "hardware.md").read_text()
-    for model in (PioneerSettings, PtuD46Settings, OpenCVCameraSettings, HttpCameraSettings):
+    for model in (PioneerSettings, PtuD46Settings, OpenCVCameraSettings, HttpCameraSettings, SafetySettings):
         for name in model.model_fields:
             assert f"`{name}`" in page, f"{model.__name__}.{name} is not in docs/hardware.md"
 

@@ -161,6 +161,11 @@ def test_viewframes_are_matched_through_times_and_sources():
         "zinf_1deg": 6, "zinf_4deg": 2, "compass": 1, "lost": 1}}}, level, tolerance=0.5)
     assert counted["estimates_pct"] == {"zinf_1deg": 60.0, "zinf_2deg": 0.0, "zinf_4deg": 20.0, "zinf_8deg": 0.0,
                                         "compass": 10.0, "no_rotation": 0.0, "lost": 10.0}
+    touched = {**repeat, "ground_truth": {**repeat["ground_truth"], "collisions": 1, "min_clearance_m": 0.0},
+               "safety": {"safety_stops": 2}}  # home, but it touched something on the way: not reached
+    collided = repeat_figures(taught, touched, level, tolerance=0.5)
+    assert not collided["reached"] and (collided["collisions"], collided["safety_stops"]) == (1, 2)
+    assert (figures["collisions"], figures["safety_stops"], figures["min_clearance_m"]) == (0, 0, None)
     assert repeat_figures(taught, None, level, tolerance=0.5) | {"reached": False} == {
         "cut": 1, "height": 1, "viewframes": 2, "landmarks": 40, "bytes": 900, "memory_fraction": 0.5,
         "status": "ERROR", "reached": False}
@@ -180,6 +185,7 @@ def test_the_evaluation_on_a_small_world_file(world_file, tmp_path, capsys):
     assert all(a["memory_pct"] > b["memory_pct"] for a, b in zip(rows[:-1], rows[1:], strict=True))
     assert rows[0]["height"] == figures["teach.height"] and rows[-1]["height"] == 0
     assert figures["full.goal_reached"] == 1 and figures["full.path_error_m"] < 0.2  # the full tree leads home
+    assert figures["full.collisions"] == 0 and figures["teach.collisions"] == 0
     assert figures["full.viewframe_error_m"] < 0.6
     shares = rows[0]["estimates_pct"]  # every estimate of the full tree's repeat counted by its rule
     assert shares.keys() == {"zinf_1deg", "zinf_2deg", "zinf_4deg", "zinf_8deg", "compass", "no_rotation", "lost"}
@@ -192,7 +198,8 @@ def test_the_evaluation_on_a_small_world_file(world_file, tmp_path, capsys):
     assert main([*args, "--resume"]) == 0
     table = capsys.readouterr().out
     assert "small_room" in table and "goal reached by every seed down to" in table
-    assert len(table.splitlines()) == 6 + len(rows)
+    assert "teaching: 0 coll, 0 stops, clear " in table  # the clearance is the sonar's, when the world has ranges
+    assert len(table.splitlines()) == 7 + len(rows)
     assert len((out / "results.jsonl").read_text().splitlines()) == 1 + len(rows)
     assert format_table(figures) == table.rstrip("\n")
 
