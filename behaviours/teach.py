@@ -14,7 +14,8 @@ the map's figures and, per viewframe, the tree time it was made (``taught``); an
 turns those times into places with the simulator's ground-truth trajectory. With gap filling
 (``gap_filling``, :mod:`maps.ltmap.gaps`) it also counts the landmarks found again and shifted
 to a common node (``shifted``) and lists the loops the route closed (``loops``: the viewframe
-pair, as taught, and the landmarks shared; ``loop_closures``: how many).
+pair, as taught, and the landmarks shared; ``loop_closures``: how many stretches of route came
+back past earlier places, consecutive viewframes with a loop counting once).
 """
 
 from __future__ import annotations
@@ -73,6 +74,8 @@ class LearnRoute(BearingsDecorator):
         self.prunes = 0
         self.shifted = 0  # landmarks found again and merged into a common node (gap filling)
         self.loops: list[dict[str, int | list[int]]] = []  # viewframe pairs where the route came back
+        self.closures = 0  # runs of consecutive viewframes that closed loops: one way back past earlier places
+        self._looping = False
         self.saved = False
         self._stamp: float | None = None
         self._logged = -1
@@ -80,7 +83,7 @@ class LearnRoute(BearingsDecorator):
     def initialise(self) -> None:
         self.learner = RouteLearner(self.config)
         self.taught, self.places, self.prunes, self.saved, self._stamp = [], [], 0, False, None
-        self.shifted, self.loops = 0, []
+        self.shifted, self.loops, self.closures, self._looping = 0, [], 0, False
 
     def update(self) -> Status:
         self._learn()
@@ -106,6 +109,9 @@ class LearnRoute(BearingsDecorator):
         self.shifted += step.shifted
         if step.loop is not None:
             self.loops.append({"viewframes": [step.loop.earlier, step.loop.later], "shared": step.loop.shared})
+            self.closures += not self._looping
+        if step.created:
+            self._looping = step.loop is not None
         if step.pruned is not None and step.pruned.fits:
             self.prunes += 1
             kept: dict[int, int] = {}  # new viewframe -> the earliest old one it came from
@@ -150,7 +156,7 @@ class LearnRoute(BearingsDecorator):
         yield from section("ltmap", {**summary_section(tree.summary()), "map_file": self.get_input(self.PATH),
                                      "saved": self.saved, "online_prunes": self.prunes, "taught": taught,
                                      "gap_filling": self.config.gap_filling, "shifted": self.shifted,
-                                     "loops": list(self.loops), "loop_closures": len(self.loops)})
+                                     "loops": list(self.loops), "loop_closures": self.closures})
 
     def drawings(self) -> Iterator[Drawing]:
         """The viewframes made so far, where odometry put them (when there are new ones)."""

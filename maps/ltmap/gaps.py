@@ -44,9 +44,16 @@ shifting the respective landmark to a common node in a higher level of the tree.
   high: "seen unmoved from two places" does not make a landmark visible from everywhere between.
 - **Loops.** A landmark found again whose two copies were seen with more than ``max_gap``
   viewframes between them (seen, then not, then again) means the route came back past an
-  earlier place. The earlier viewframe that holds most of them is the loop's other end;
-  ``min_loop`` of them (Z-infinity's minimum of 8) make a loop (:class:`Loop`: the viewframe
-  pair and the landmarks shared). By the rule above they are not shifted: the common node of two
+  earlier place. The earlier viewframe that holds most of them is the loop's other end; as many
+  of them as homing needs make a loop (:class:`Loop`: the viewframe pair and the landmarks
+  shared): ``min_loop``, the paper's 50, or half a small viewframe, never under Z-infinity's 8
+  (:func:`perception.viewframe_motion.lost_threshold`, the rule route following loses a
+  viewframe by). Z-infinity's 8 alone was tried: on the lab's tour, which never comes back,
+  landmarks that ORB missed for 4 or 5 viewframes and found again made 1.2 "loops" per teach
+  (8 to 11 landmarks each), while on the route back past the tour (``route=back`` of the
+  evaluation) the true ones share 30 to 160. A route back past several places closes a loop at
+  each of its viewframes; the teach report lists them all and counts consecutive ones as one
+  closure. By the rule above they are not shifted: the common node of two
   passes of one place covers the whole way between, which never saw them. A loop is reported
   (the teach's ``ltmap.loops``), the map does not hold it, and route following does not use it.
 
@@ -62,18 +69,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from maps.ltmap.arrays import IDS
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
 from perception.matching import match_within
 from perception.similarity import bearing_angles
-from perception.viewframe_motion import ZINF_MIN_LANDMARKS
+from perception.viewframe_motion import lost_threshold
 
 
 @dataclass(frozen=True, slots=True)
 class GapConfig:
     """``max_gap``: viewframes a shift may give a landmark they did not see; ``min_loop``: landmarks
-    found again from one earlier place that make a loop."""
+    found again from one earlier place that make a loop (the paper's 50 for homing; a small
+    viewframe needs half its landmarks: :func:`perception.viewframe_motion.lost_threshold`)."""
 
     max_gap: int = 2
-    min_loop: int = ZINF_MIN_LANDMARKS
+    min_loop: int = DEFAULT_MIN_LANDMARKS
 
     def __post_init__(self) -> None:
         if self.max_gap < 0 or self.min_loop < 1:
@@ -172,9 +181,10 @@ def _same_ids(ids: np.ndarray, candidates: np.ndarray) -> np.ndarray:
 
 
 def plan_shifts(parent: Sequence[int], leaves: Sequence[int], landmark_nodes: np.ndarray, pairs: np.ndarray,
-                config: GapConfig) -> ShiftPlan:
-    """Which of ``pairs`` (rows stored twice, found by :func:`found_again` for the last viewframe)
-    become one landmark in their common node, and the loop they show (see the module doc)."""
+                config: GapConfig, *, viewframe_size: int | None = None) -> ShiftPlan:
+    """Which of ``pairs`` (rows stored twice, found by :func:`found_again` for the last viewframe,
+    of ``viewframe_size`` landmarks) become one landmark in their common node, and the loop they
+    show (see the module doc)."""
     first, last = node_cover(parent, leaves)
     later = len(leaves) - 1
     node = np.array(landmark_nodes, dtype=np.int64)
@@ -204,7 +214,8 @@ def plan_shifts(parent: Sequence[int], leaves: Sequence[int], landmark_nodes: np
             node[keep], kept[drop] = common, keep
             shifts.append((keep, drop, common))
     rows = np.array(shifts, dtype=np.int64).reshape(-1, 3)
-    return ShiftPlan(rows[:, 0], rows[:, 1], rows[:, 2], _loop(evidence, later, config.min_loop))
+    min_loop = config.min_loop if viewframe_size is None else lost_threshold(viewframe_size, config.min_loop)
+    return ShiftPlan(rows[:, 0], rows[:, 1], rows[:, 2], _loop(evidence, later, min_loop))
 
 
 def _span(first: int, last: int) -> int:

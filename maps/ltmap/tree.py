@@ -370,7 +370,7 @@ class LandmarkTree:
             return GapFill(0, 0, None, np.arange(0))
         candidates = np.flatnonzero(np.isin(self._rows.node, self.branch_nodes(-1)))
         pairs = found_again(self.kind, self._rows.data, self._rows.bearings, candidates, share_angle, ratio=ratio)
-        plan = plan_shifts(self._parent, self._leaves, self._rows.node, pairs, config)
+        plan = plan_shifts(self._parent, self._leaves, self._rows.node, pairs, config, viewframe_size=len(candidates))
         index = np.arange(self.landmark_count)
         if len(plan.drop):
             self._rows.node[plan.keep] = plan.node
