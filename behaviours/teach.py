@@ -20,6 +20,7 @@ back past earlier places, consecutive viewframes with a loop counting once).
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from typing import Any
 
@@ -153,10 +154,13 @@ class LearnRoute(BearingsDecorator):
         if tree is None:
             return
         taught = [{"viewframe": i, "time_s": t} for i, t in enumerate(self.taught)]
-        yield from section("ltmap", {**summary_section(tree.summary()), "map_file": self.get_input(self.PATH),
-                                     "saved": self.saved, "online_prunes": self.prunes, "taught": taught,
+        path = self.get_input(self.PATH)
+        written = os.path.abspath(path) if path else ""  # said at the end of the run: where the map went
+        yield from section("ltmap", {**summary_section(tree.summary()), "map_file": written, "saved": self.saved,
+                                     "online_prunes": self.prunes, "taught": taught,
                                      "gap_filling": self.config.gap_filling, "shifted": self.shifted,
-                                     "loops": list(self.loops), "loop_closures": self.closures})
+                                     "loops": list(self.loops), "loop_closures": self.closures},
+                           headline=("viewframes", "map_file"))
 
     def drawings(self) -> Iterator[Drawing]:
         """The viewframes made so far, where odometry put them (when there are new ones)."""
