@@ -10,6 +10,13 @@ Four variants of the shipped ``explore`` mission, each over the same seeds:
   measures the gaze, fixed vs baseline the goal selection);
 - ``eq1``: eq. 1 over all points, as the paper writes it, the cameras watching interest edges.
 
+Two more run when named (``--option variants=method,gaze_before,...``: the variants to run, the
+method always among them): ``gaze_before``, the method with the gaze's earlier rules (a watched
+point dropped once its bearing passes 90 degrees, ``leave: pan_limit``; the head turned back to
+straight ahead, ``turn_back: front``), so method vs gaze_before measures eq. 3 and eq. 4; and
+``closest_edges``, the closest reachable border with the cameras watching interest edges (the
+goal selection alone against the method's).
+
 The measure (ground truth, evaluation only). The reference is the world's reachable floor
 (:func:`drivers.sim.floor.reachable_floor`: where the robot's centre can go from the start). What
 was *explored* is what the cameras actually saw: every stereo observation is in the run report as
@@ -24,17 +31,27 @@ and ``map_on_obstacles_m2`` is how much of that map's explored floor lies on wal
 
 Figures per variant (means over seeds unless named otherwise): final ``coverage``, its minimum,
 ``ok`` (episodes that ended by themselves with coverage >= 0.95 and no collision), ``done``,
-``collisions``, ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
+``collisions`` and ``safety_stops`` (summed over the runs), ``min_clearance_m`` (the smallest, when
+the simulator reports it), ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
 and after 60, 120 and 240 s, and the path length and time to reach 50, 80, 90 and 95 % (None when
 not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m and
 120 s, of its path and time to 90 and 95 % and of its path length to the three others' (below 1
 for a path or a time: the method's is shorter).
+
+People (``--option people=N``, :mod:`experiments.eval.people`): N people drawn from the seed,
+standing in the rooms or walking back and forth between two points of the floor the robot
+reaches, none within 1 m of the start, are added to a copy of the world file
+(``people/s<seed>/<world>.yaml`` in the results folder) that every variant of that seed runs in.
+The reference floor stays the world's (people move: they hide no floor for good). The figures
+record the people placed (``people.placed``, ``people.paths``).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import cv2
@@ -44,6 +61,8 @@ from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.simulation import start_to_world
 from drivers.sim.world import load_world
 from experiments.eval import EvalOptions
+from experiments.eval import people as crowd
+from experiments.eval.figures import safety_figures, safety_totals
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.table import read_report
@@ -60,12 +79,26 @@ VARIANTS: dict[str, dict[str, str]] = {
     "baseline": {"strategy": "closest_frontier", "gaze": "fixed"},
     "fixed": {"strategy": "nearby_attraction", "gaze": "fixed"},
     "eq1": {"strategy": "attraction", "gaze": "edges"},
+    "gaze_before": {"strategy": "nearby_attraction", "gaze": "edges", "leave": "pan_limit", "turn_back": "front"},
+    "closest_edges": {"strategy": "closest_frontier", "gaze": "edges"},
 }
+DEFAULT_VARIANTS = ("method", "baseline", "fixed", "eq1")
 DISTANCES = (5.0, 10.0, 20.0, 40.0)  # m of path: coverage reached by then
 TIMES = (60.0, 120.0, 240.0)  # s
 LEVELS = (0.5, 0.8, 0.9, 0.95)  # coverage: path length and time to reach it
 RESOLUTION = 0.05  # m: the reference floor grid
 GOAL = 0.95  # the issue's criterion
+OPTIONS = {crowd.OPTION: crowd.HELP + " (in the rooms)",
+           "variants": f"the variants to run, comma-separated ({', '.join(VARIANTS)}; default "
+                       f"{','.join(DEFAULT_VARIANTS)}; the method always runs)"}
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The area's options, checked: people per seed and the variants to run (the method first)."""
+
+    people: int = 0
+    variants: tuple[str, ...] = DEFAULT_VARIANTS
 
 
 def check_world(world: str) -> FloorGrid:
@@ -77,14 +110,44 @@ def check_world(world: str) -> FloorGrid:
     return floor
 
 
-def episodes(world: str, seeds: Sequence[int], max_time_s: float | None = None) -> list[Episode]:
-    """The evaluation's runs: every variant on every seed."""
-    return [Episode(MISSION, world, seed, inputs, max_time_s) for inputs in VARIANTS.values() for seed in seeds]
+def check_options(world: str, extra: Mapping[str, str]) -> Settings:
+    """The options (``OPTIONS``) checked; ``ValueError`` with the problem."""
+    text = extra.get("variants")
+    names = [n.strip() for n in text.split(",") if n.strip()] if text is not None else list(DEFAULT_VARIANTS)
+    unknown = [n for n in names if n not in VARIANTS]
+    if unknown or not names:
+        raise ValueError(f"variants={text!r}: {', '.join(unknown) or 'none named'} "
+                         f"(known: {', '.join(VARIANTS)})")
+    variants = ("method", *dict.fromkeys(n for n in names if n != "method"))
+    return Settings(crowd.parse_people(extra.get(crowd.OPTION)), variants)
+
+
+def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: float | None = None,
+             variants: Sequence[str] = DEFAULT_VARIANTS) -> list[Episode]:
+    """The evaluation's runs: every variant named on every seed (in ``world``, or per seed ``world[seed]``)."""
+    where = world if isinstance(world, Mapping) else dict.fromkeys(seeds, world)
+    return [Episode(MISSION, where[seed], seed, VARIANTS[name], max_time_s) for name in variants for seed in seeds]
+
+
+def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
+                folder: Path) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
+    """Per seed, the world its runs go in (with ``count`` people in the rooms: module docstring) and
+    those people; the world itself when there are none."""
+    if not count:
+        return dict.fromkeys(seeds, world), {}
+    loaded = load_world(world)
+    start = [(loaded.start.x, loaded.start.y)]
+    people = {seed: crowd.in_rooms(loaded, floor, count, seed, keep_clear=start) for seed in seeds}
+    worlds = {seed: str(crowd.world_with_people(world, folder / "people" / f"s{seed:04d}" / f"{Path(world).stem}.yaml",
+                                                people[seed])) for seed in seeds}
+    return worlds, people
 
 
 def variant_of(inputs: dict[str, Any]) -> str:
+    """The variant whose inputs are exactly ``inputs``."""
+    given = {k: str(v) for k, v in inputs.items() if v is not None}
     for name, values in VARIANTS.items():
-        if all(str(inputs.get(k)) == v for k, v in values.items()):
+        if given == values:
             return name
     raise KeyError(f"no variant has the inputs {inputs}")
 
@@ -164,7 +227,7 @@ def episode_figures(report: dict[str, Any] | None, floor: FloorGrid, robot_radiu
         "coverage": coverage,
         "coverage_map": floor.coverage(placed) if len(placed) else 0.0,
         "map_on_obstacles_m2": on_obstacles * floor.resolution**2,
-        "collisions": int(truth.get("collisions", 0)),
+        **safety_figures(report),
         "path_length_m": float(truth["trajectory_length_m"]),
         "sim_time_s": float(report.get("sim_time_s", truth.get("sim_time_s", 0.0))),
         "odometry_drift_m": float(truth.get("odometry_drift_m", math.nan)),
@@ -229,7 +292,7 @@ def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
         values = [r.get(key) for r in good]
         if good and any(key in r for r in good):
             out[key] = _mean(values)
-    out["collisions"] = sum(int(r.get("collisions", 0)) for r in good)  # a count over the runs, not a mean
+    out.update(safety_totals(good))  # counts over the runs, not means; the smallest clearance
     return out
 
 
@@ -240,11 +303,15 @@ def _ratio(a: float | None, b: float | None) -> float | None:
 def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Run the episodes through the sweep runner and compute the figures."""
     floor = options.checked[0] if options.checked else check_world(options.world)
+    settings = options.checked[1] if options.checked and options.checked[1] is not None else check_options(
+        options.world, options.extra)
+    count = settings.people
     world = load_world(options.world)
-    todo = episodes(options.world, options.seeds, options.max_time_s)
+    where, people = seed_worlds(options.world, count, options.seeds, floor, Path(options.results_dir).resolve())
+    todo = episodes(where, options.seeds, options.max_time_s, settings.variants)
     rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,
                      progress=options.progress, resume=resume)
-    by_variant: dict[str, list[dict[str, Any]]] = {name: [] for name in VARIANTS}
+    by_variant: dict[str, list[dict[str, Any]]] = {name: [] for name in settings.variants}
     runs = []
     for row in rows:
         report = read_report(options.results_dir, row["id"])
@@ -262,20 +329,20 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     summary = {name: summarise_variant(v) for name, v in by_variant.items() if v}
     for name, figures in summary.items():
         out.update({f"{name}.{key}": value for key, value in figures.items()})
-    for other in ("fixed", "baseline", "eq1"):
+    for other in [n for n in settings.variants if n != "method" and n in summary]:
         for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s", "path_to_90pct_m", "path_to_95pct_m",
                     "time_to_90pct_s", "time_to_95pct_s"):
             out[f"method_vs_{other}.{key}_ratio"] = _ratio(summary["method"].get(key), summary[other].get(key))
         out[f"method_vs_{other}.path_length_ratio"] = _ratio(summary["method"].get("path_length_m"),
                                                               summary[other].get("path_length_m"))
     out["runs"] = sorted(runs, key=lambda r: (r["variant"], r["seed"]))
-    return out
+    return {**out, **crowd.figures(people, count)} if count else out
 
 
 def format_table(figures: dict[str, Any]) -> str:
     """The comparison as a readable table (one column per variant)."""
-    keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "collisions", "path_length_m", "sim_time_s",
-            *CURVE_FIGURES]
+    keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "collisions", "safety_stops", "min_clearance_m",
+            "path_length_m", "sim_time_s", *CURVE_FIGURES]
     names = [n for n in VARIANTS if f"{n}.coverage" in figures]
     lines = [f"exploration in {figures['world']}: {figures['seeds']} seed(s), reachable floor "
              f"{figures['reachable_area_m2']:.1f} m^2 ({figures['criterion']})",
@@ -287,4 +354,4 @@ def format_table(figures: dict[str, Any]) -> str:
             text = "-" if value is None else f"{value:.3g}" if isinstance(value, float) else str(value)
             cells.append(text.rjust(12))
         lines.append(key.ljust(24) + "".join(cells))
-    return "\n".join(lines)
+    return "\n".join(lines + crowd.table_line(figures))

@@ -11,6 +11,7 @@ import pytest
 
 from drivers.sim.world import load_world
 from experiments.eval.exploration import (
+    check_options,
     check_world,
     episode_figures,
     episodes,
@@ -93,6 +94,18 @@ def test_four_variants_per_seed():
     assert len(runs) == 8 and {e.inputs["gaze"] for e in runs} == {"edges", "fixed"}
     assert {e.inputs["strategy"] for e in runs} == {"nearby_attraction", "attraction", "closest_frontier"}
     assert {variant_of(e.inputs) for e in runs} == {"method", "baseline", "fixed", "eq1"}
+
+
+def test_the_variants_option_names_the_runs_and_the_method_always_runs():
+    settings = check_options("lab", {"variants": "gaze_before, closest_edges"})
+    assert settings.variants == ("method", "gaze_before", "closest_edges") and settings.people == 0
+    runs = episodes("lab", [0], variants=settings.variants)
+    # the method and gaze_before differ only in the two gaze rules; each run maps back to its own variant
+    assert [variant_of(e.inputs) for e in runs] == ["method", "gaze_before", "closest_edges"]
+    assert runs[1].inputs == {**runs[0].inputs, "leave": "pan_limit", "turn_back": "front"}
+    assert check_options("lab", {}).variants == ("method", "baseline", "fixed", "eq1")
+    with pytest.raises(ValueError, match="nearest"):
+        check_options("lab", {"variants": "method,nearest"})
 
 
 def test_the_command_refuses_an_open_world_and_bad_numbers(capsys):
