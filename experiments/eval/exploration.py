@@ -1,12 +1,21 @@
-"""``bearings eval exploration``: explored floor against path length and time, three ways.
+"""``bearings eval exploration``: explored floor against path length and time, four ways.
 
-Three variants of the shipped ``explore`` mission, each over the same seeds:
+Four variants of the shipped ``explore`` mission, each over the same seeds:
 
-- ``method``: attractive power (eq. 1) with frontier mode, the cameras watching interest edges;
+- ``method``: the mission's default, attractive power (eq. 1) among the borders about as close as
+  the closest (``nearby_attraction``), frontier mode otherwise, the cameras watching interest edges;
 - ``baseline``: the closest reachable border always (classic frontier exploration), cameras fixed
   straight ahead;
 - ``fixed``: the method's goal selection with the cameras fixed straight ahead (so method vs fixed
-  measures the gaze, fixed vs baseline the goal selection).
+  measures the gaze, fixed vs baseline the goal selection);
+- ``eq1``: eq. 1 over all points, as the paper writes it, the cameras watching interest edges.
+
+Two more run when named (``--option variants=method,gaze_before,...``: the variants to run, the
+method always among them): ``gaze_before``, the method with the gaze's earlier rules (a watched
+point dropped once its bearing passes 90 degrees, ``leave: pan_limit``; the head turned back to
+straight ahead, ``turn_back: front``), so method vs gaze_before measures eq. 3 and eq. 4; and
+``closest_edges``, the closest reachable border with the cameras watching interest edges (the
+goal selection alone against the method's).
 
 The measure (ground truth, evaluation only). The reference is the world's reachable floor
 (:func:`drivers.sim.floor.reachable_floor`: where the robot's centre can go from the start). What
@@ -25,8 +34,9 @@ Figures per variant (means over seeds unless named otherwise): final ``coverage`
 ``collisions`` and ``safety_stops`` (summed over the runs), ``min_clearance_m`` (the smallest, when
 the simulator reports it), ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
 and after 60, 120 and 240 s, and the path length and time to reach 50, 80, 90 and 95 % (None when
-not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m to
-the two others'.
+not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m and
+120 s, of its path and time to 90 and 95 % and of its path length to the three others' (below 1
+for a path or a time: the method's is shorter).
 
 People (``--option people=N``, :mod:`experiments.eval.people`): N people drawn from the seed,
 standing in the rooms or walking back and forth between two points of the floor the robot
@@ -40,6 +50,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -61,19 +72,33 @@ from maps.exploration.head import StereoHead
 from maps.exploration.integrate import scan_cells
 from perception.geometry import Pose2D
 
-DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed"
+DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed, eq. 1"
 MISSION = "explore"
 VARIANTS: dict[str, dict[str, str]] = {
-    "method": {"strategy": "attraction", "gaze": "edges"},
+    "method": {"strategy": "nearby_attraction", "gaze": "edges"},
     "baseline": {"strategy": "closest_frontier", "gaze": "fixed"},
-    "fixed": {"strategy": "attraction", "gaze": "fixed"},
+    "fixed": {"strategy": "nearby_attraction", "gaze": "fixed"},
+    "eq1": {"strategy": "attraction", "gaze": "edges"},
+    "gaze_before": {"strategy": "nearby_attraction", "gaze": "edges", "leave": "pan_limit", "turn_back": "front"},
+    "closest_edges": {"strategy": "closest_frontier", "gaze": "edges"},
 }
+DEFAULT_VARIANTS = ("method", "baseline", "fixed", "eq1")
 DISTANCES = (5.0, 10.0, 20.0, 40.0)  # m of path: coverage reached by then
 TIMES = (60.0, 120.0, 240.0)  # s
 LEVELS = (0.5, 0.8, 0.9, 0.95)  # coverage: path length and time to reach it
 RESOLUTION = 0.05  # m: the reference floor grid
 GOAL = 0.95  # the issue's criterion
-OPTIONS = {crowd.OPTION: crowd.HELP + " (in the rooms)"}
+OPTIONS = {crowd.OPTION: crowd.HELP + " (in the rooms)",
+           "variants": f"the variants to run, comma-separated ({', '.join(VARIANTS)}; default "
+                       f"{','.join(DEFAULT_VARIANTS)}; the method always runs)"}
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The area's options, checked: people per seed and the variants to run (the method first)."""
+
+    people: int = 0
+    variants: tuple[str, ...] = DEFAULT_VARIANTS
 
 
 def check_world(world: str) -> FloorGrid:
@@ -85,15 +110,23 @@ def check_world(world: str) -> FloorGrid:
     return floor
 
 
-def check_options(world: str, extra: Mapping[str, str]) -> int:
-    """The options (``OPTIONS``) checked: the number of people; ``ValueError`` with the problem."""
-    return crowd.parse_people(extra.get(crowd.OPTION))
+def check_options(world: str, extra: Mapping[str, str]) -> Settings:
+    """The options (``OPTIONS``) checked; ``ValueError`` with the problem."""
+    text = extra.get("variants")
+    names = [n.strip() for n in text.split(",") if n.strip()] if text is not None else list(DEFAULT_VARIANTS)
+    unknown = [n for n in names if n not in VARIANTS]
+    if unknown or not names:
+        raise ValueError(f"variants={text!r}: {', '.join(unknown) or 'none named'} "
+                         f"(known: {', '.join(VARIANTS)})")
+    variants = ("method", *dict.fromkeys(n for n in names if n != "method"))
+    return Settings(crowd.parse_people(extra.get(crowd.OPTION)), variants)
 
 
-def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: float | None = None) -> list[Episode]:
-    """The evaluation's runs: every variant on every seed (in ``world``, or per seed ``world[seed]``)."""
+def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: float | None = None,
+             variants: Sequence[str] = DEFAULT_VARIANTS) -> list[Episode]:
+    """The evaluation's runs: every variant named on every seed (in ``world``, or per seed ``world[seed]``)."""
     where = world if isinstance(world, Mapping) else dict.fromkeys(seeds, world)
-    return [Episode(MISSION, where[seed], seed, inputs, max_time_s) for inputs in VARIANTS.values() for seed in seeds]
+    return [Episode(MISSION, where[seed], seed, VARIANTS[name], max_time_s) for name in variants for seed in seeds]
 
 
 def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
@@ -111,8 +144,10 @@ def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
 
 
 def variant_of(inputs: dict[str, Any]) -> str:
+    """The variant whose inputs are exactly ``inputs``."""
+    given = {k: str(v) for k, v in inputs.items() if v is not None}
     for name, values in VARIANTS.items():
-        if all(str(inputs.get(k)) == v for k, v in values.items()):
+        if given == values:
             return name
     raise KeyError(f"no variant has the inputs {inputs}")
 
@@ -268,14 +303,15 @@ def _ratio(a: float | None, b: float | None) -> float | None:
 def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Run the episodes through the sweep runner and compute the figures."""
     floor = options.checked[0] if options.checked else check_world(options.world)
-    count = options.checked[1] if options.checked and options.checked[1] is not None else check_options(
+    settings = options.checked[1] if options.checked and options.checked[1] is not None else check_options(
         options.world, options.extra)
+    count = settings.people
     world = load_world(options.world)
     where, people = seed_worlds(options.world, count, options.seeds, floor, Path(options.results_dir).resolve())
-    todo = episodes(where, options.seeds, options.max_time_s)
+    todo = episodes(where, options.seeds, options.max_time_s, settings.variants)
     rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,
                      progress=options.progress, resume=resume)
-    by_variant: dict[str, list[dict[str, Any]]] = {name: [] for name in VARIANTS}
+    by_variant: dict[str, list[dict[str, Any]]] = {name: [] for name in settings.variants}
     runs = []
     for row in rows:
         report = read_report(options.results_dir, row["id"])
@@ -293,8 +329,9 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     summary = {name: summarise_variant(v) for name, v in by_variant.items() if v}
     for name, figures in summary.items():
         out.update({f"{name}.{key}": value for key, value in figures.items()})
-    for other in ("fixed", "baseline"):
-        for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s"):
+    for other in [n for n in settings.variants if n != "method" and n in summary]:
+        for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s", "path_to_90pct_m", "path_to_95pct_m",
+                    "time_to_90pct_s", "time_to_95pct_s"):
             out[f"method_vs_{other}.{key}_ratio"] = _ratio(summary["method"].get(key), summary[other].get(key))
         out[f"method_vs_{other}.path_length_ratio"] = _ratio(summary["method"].get("path_length_m"),
                                                               summary[other].get("path_length_m"))
