@@ -1,6 +1,7 @@
 """``bearings eval exploration``: explored floor against path length and time, three ways.
 
-Three variants of the shipped ``explore`` mission, each over the same seeds:
+Three variants of the shipped ``explore`` mission, each over the same seeds (and with each
+localisation the ``localisation`` option names, see below):
 
 - ``method``: attractive power (eq. 1) with frontier mode, the cameras watching interest edges;
 - ``baseline``: the closest reachable border always (classic frontier exploration), cameras fixed
@@ -26,12 +27,23 @@ Figures per variant (means over seeds unless named otherwise): final ``coverage`
 and after 60, 120 and 240 s, and the path length and time to reach 50, 80, 90 and 95 % (None when
 not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m to
 the two others'.
+
+Localisation (option ``localisation``): ``visual`` (the default) runs the mission as shipped, its pose
+from the stereo pair's own features; ``ideal`` gives it the simulator's identified landmarks (the
+oracle no robot has); ``visual,ideal`` runs both, the ideal columns named ``VARIANT/ideal``, so the
+table shows what the oracle was worth (and ``VARIANT_visual_vs_ideal`` ratios of the map's area on
+obstacles and of the path). The pose figures compare the localisation's pose (the report's
+``exploration.localisation``: its final pose and a track of one row a second) with the truth at
+the same time, the odometry frame placed at the true start: ``pose_error_m`` and
+``heading_error_deg`` at the end, their maxima over the run, the position error after 60, 120 and
+240 s, the final ``pose_sigma_m`` the localisation gave itself, and ``pose_ok`` (episodes that end
+within 0.10 m and 2 degrees).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import cv2
@@ -48,7 +60,7 @@ from maps.exploration.codec import unpack_cells
 from maps.exploration.grid import GridFrame
 from maps.exploration.head import StereoHead
 from maps.exploration.integrate import scan_cells
-from perception.geometry import Pose2D
+from perception.geometry import Pose2D, wrap_angle
 
 DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed"
 MISSION = "explore"
@@ -62,6 +74,12 @@ TIMES = (60.0, 120.0, 240.0)  # s
 LEVELS = (0.5, 0.8, 0.9, 0.95)  # coverage: path length and time to reach it
 RESOLUTION = 0.05  # m: the reference floor grid
 GOAL = 0.95  # the issue's criterion
+OPTIONS = {
+    "localisation": "how the robot localises: visual (the stereo pair's own features; default), ideal (the "
+                    "simulator's identified landmarks, an oracle), or visual,ideal (both, side by side)",
+}
+LOCALISATIONS = {"visual": "stereo", "ideal": "landmarks"}  # -> the mission's localisation input (a camera)
+POSE_GOAL = (0.10, 2.0)  # m, deg: the localisation's error at the end of a run
 
 
 def check_world(world: str) -> FloorGrid:
@@ -73,15 +91,39 @@ def check_world(world: str) -> FloorGrid:
     return floor
 
 
-def episodes(world: str, seeds: Sequence[int], max_time_s: float | None = None) -> list[Episode]:
-    """The evaluation's runs: every variant on every seed."""
-    return [Episode(MISSION, world, seed, inputs, max_time_s) for inputs in VARIANTS.values() for seed in seeds]
+def check_options(world: str, extra: Mapping[str, str]) -> tuple[str, ...]:
+    """The localisations the ``localisation`` option names, checked against the world's cameras."""
+    names = tuple(dict.fromkeys(n.strip() for n in extra.get("localisation", "visual").split(",")))
+    unknown = [n for n in names if n not in LOCALISATIONS]
+    if unknown or not names:
+        raise ValueError(f"localisation must be visual, ideal or visual,ideal, got {extra.get('localisation')!r}")
+    cameras = {spec.name for spec in load_world(world).cameras}
+    for name in names:
+        if LOCALISATIONS[name] not in cameras:
+            raise ValueError(f"localisation {name} needs the camera {LOCALISATIONS[name]!r}, which world {world!r} "
+                             f"does not have (cameras: {', '.join(sorted(cameras))})")
+    return names
+
+
+def column(variant: str, localisation: str) -> str:
+    """A table column: the variant, with ``/ideal`` for the ideal localisation."""
+    return variant if localisation == "visual" else f"{variant}/{localisation}"
+
+
+def episodes(world: str, seeds: Sequence[int], max_time_s: float | None = None,
+             localisations: Sequence[str] = ("visual",)) -> list[Episode]:
+    """The evaluation's runs: every variant on every seed, with every localisation."""
+    return [Episode(MISSION, world, seed, {**inputs, "localisation": LOCALISATIONS[loc]}, max_time_s)
+            for loc in localisations for inputs in VARIANTS.values() for seed in seeds]
 
 
 def variant_of(inputs: dict[str, Any]) -> str:
+    """The column of an episode's inputs (:func:`column`)."""
+    camera = str(inputs.get("localisation", LOCALISATIONS["visual"]))
+    localisation = next((k for k, v in LOCALISATIONS.items() if v == camera), None)
     for name, values in VARIANTS.items():
-        if all(str(inputs.get(k)) == v for k, v in values.items()):
-            return name
+        if localisation is not None and all(str(inputs.get(k)) == v for k, v in values.items()):
+            return column(name, localisation)
     raise KeyError(f"no variant has the inputs {inputs}")
 
 
@@ -136,6 +178,37 @@ def map_in_world(report: dict[str, Any]) -> np.ndarray:
     return start_to_world(Pose2D(x0, y0, th0), local)
 
 
+def pose_errors(report: dict[str, Any]) -> dict[str, Any]:
+    """The localisation's pose against the truth (module docstring); empty without a pose track."""
+    located = report.get("exploration", {}).get("localisation", {})
+    track = np.asarray(located.get("track", []), dtype=np.float64).reshape(-1, 6)
+    final = located.get("final_pose")
+    if not len(track) or not final:
+        return {}
+    trajectory = TrueTrajectory(report["ground_truth"])
+    start = trajectory.at(0.0)
+
+    def error(t: float, x: float, y: float, theta: float) -> tuple[float, float]:
+        truth = trajectory.at(t)
+        world = start_to_world(start, np.array([[x, y]]))[0]
+        return (math.hypot(world[0] - truth.x, world[1] - truth.y),
+                math.degrees(abs(wrap_angle(theta + start.theta - truth.theta))))
+
+    over_time = np.array([error(*row[:4]) for row in track])
+    end = error(final["t"], final["x"], final["y"], final["theta"])
+    out: dict[str, Any] = {
+        "pose_error_m": end[0], "heading_error_deg": end[1],
+        "pose_error_max_m": float(max(over_time[:, 0].max(), end[0])),
+        "heading_error_max_deg": float(max(over_time[:, 1].max(), end[1])),
+        "pose_sigma_m": float(located.get("position_sigma_m", math.nan)),
+        "pose_ok": bool(end[0] <= POSE_GOAL[0] and end[1] <= POSE_GOAL[1]),
+    }
+    for t in TIMES:
+        before = np.flatnonzero(track[:, 0] <= t)
+        out[f"pose_error_at_{t:g}s_m"] = float(over_time[before[-1], 0]) if len(before) else None
+    return out
+
+
 def _first(curve: np.ndarray, level: float, column: int) -> float | None:
     hit = np.flatnonzero(curve[:, 2] >= level)
     return float(curve[hit[0], column]) if len(hit) else None
@@ -167,6 +240,7 @@ def episode_figures(report: dict[str, Any] | None, floor: FloorGrid, robot_radiu
         "wall_time_s": float(report.get("wall_time_s", math.nan)),
     }
     out["ok"] = bool(done and coverage >= GOAL and out["collisions"] == 0)
+    out.update(pose_errors(report))
     for d in DISTANCES:
         out[f"coverage_at_{d:g}m"] = _coverage_when(curve, d, 1)
     for t in TIMES:
@@ -205,6 +279,8 @@ CURVE_FIGURES = (  # per-episode figures averaged over a variant's runs and show
     *(f"path_to_{v * 100:g}pct_m" for v in LEVELS), *(f"time_to_{v * 100:g}pct_s" for v in LEVELS),
     "goal_count", "mode_switch_count", "gaze_watching_fraction", "gaze_look_ahead_fraction",
 )
+POSE_FIGURES = ("pose_error_m", "heading_error_deg", "pose_error_max_m", "heading_error_max_deg",
+                *(f"pose_error_at_{t:g}s_m" for t in TIMES), "pose_sigma_m")
 
 
 def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
@@ -221,11 +297,13 @@ def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
     if any(r["status"] == "ERROR" for r in runs):
         out["errors"] = sum(r["status"] == "ERROR" for r in runs)
     good = [r for r in runs if r["status"] != "ERROR"]
-    for key in ("coverage_map", "map_on_obstacles_m2", "path_length_m", "sim_time_s", *CURVE_FIGURES):
+    for key in ("coverage_map", "map_on_obstacles_m2", "path_length_m", "sim_time_s", *CURVE_FIGURES, *POSE_FIGURES):
         values = [r.get(key) for r in good]
         if good and any(key in r for r in good):
             out[key] = _mean(values)
     out["collisions"] = sum(int(r.get("collisions", 0)) for r in good)  # a count over the runs, not a mean
+    if any("pose_ok" in r for r in good):
+        out["pose_ok"] = sum(bool(r.get("pose_ok")) for r in good)
     return out
 
 
@@ -235,12 +313,14 @@ def _ratio(a: float | None, b: float | None) -> float | None:
 
 def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Run the episodes through the sweep runner and compute the figures."""
-    floor = options.checked[0] if options.checked else check_world(options.world)
+    floor, localisations = options.checked or (check_world(options.world),
+                                               check_options(options.world, options.extra))
     world = load_world(options.world)
-    todo = episodes(options.world, options.seeds, options.max_time_s)
+    todo = episodes(options.world, options.seeds, options.max_time_s, localisations)
     rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,
                      progress=options.progress, resume=resume)
-    by_variant: dict[str, list[dict[str, Any]]] = {name: [] for name in VARIANTS}
+    by_variant: dict[str, list[dict[str, Any]]] = {column(name, loc): [] for loc in localisations
+                                                   for name in VARIANTS}
     runs = []
     for row in rows:
         report = read_report(options.results_dir, row["id"])
@@ -258,28 +338,36 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     summary = {name: summarise_variant(v) for name, v in by_variant.items() if v}
     for name, figures in summary.items():
         out.update({f"{name}.{key}": value for key, value in figures.items()})
-    for other in ("fixed", "baseline"):
-        for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s"):
-            out[f"method_vs_{other}.{key}_ratio"] = _ratio(summary["method"].get(key), summary[other].get(key))
-        out[f"method_vs_{other}.path_length_ratio"] = _ratio(summary["method"].get("path_length_m"),
-                                                              summary[other].get("path_length_m"))
+    for loc in localisations:
+        method = summary[column("method", loc)]
+        for other in ("fixed", "baseline"):
+            versus, theirs = f"{column('method', loc)}_vs_{column(other, loc)}", summary[column(other, loc)]
+            for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s"):
+                out[f"{versus}.{key}_ratio"] = _ratio(method.get(key), theirs.get(key))
+            out[f"{versus}.path_length_ratio"] = _ratio(method.get("path_length_m"), theirs.get("path_length_m"))
+    if {"visual", "ideal"} <= set(localisations):  # what the oracle was worth
+        for name in VARIANTS:
+            visual, ideal = summary[name], summary[column(name, "ideal")]
+            for key in ("map_on_obstacles_m2", "path_length_m"):
+                out[f"{name}_visual_vs_ideal.{key.rsplit('_', 1)[0]}_ratio"] = _ratio(visual.get(key), ideal.get(key))
     out["runs"] = sorted(runs, key=lambda r: (r["variant"], r["seed"]))
     return out
 
 
 def format_table(figures: dict[str, Any]) -> str:
     """The comparison as a readable table (one column per variant)."""
-    keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "collisions", "path_length_m", "sim_time_s",
-            *CURVE_FIGURES]
-    names = [n for n in VARIANTS if f"{n}.coverage" in figures]
+    keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "map_on_obstacles_m2", "collisions",
+            "path_length_m", "sim_time_s", *CURVE_FIGURES, "pose_ok", *POSE_FIGURES]
+    names = [column(n, loc) for loc in LOCALISATIONS for n in VARIANTS if f"{column(n, loc)}.coverage" in figures]
+    width = max(12, *(len(n) + 2 for n in names))
     lines = [f"exploration in {figures['world']}: {figures['seeds']} seed(s), reachable floor "
              f"{figures['reachable_area_m2']:.1f} m^2 ({figures['criterion']})",
-             "figure".ljust(24) + "".join(n.rjust(12) for n in names)]
+             "figure".ljust(24) + "".join(n.rjust(width) for n in names)]
     for key in keys:
         cells = []
         for name in names:
             value = figures.get(f"{name}.{key}")
             text = "-" if value is None else f"{value:.3g}" if isinstance(value, float) else str(value)
-            cells.append(text.rjust(12))
+            cells.append(text.rjust(width))
         lines.append(key.ljust(24) + "".join(cells))
     return "\n".join(lines)
