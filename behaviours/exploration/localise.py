@@ -178,7 +178,7 @@ class LocalisePose(BearingsBehaviour):
             return
         pose, covariance = self.pose_and_covariance()
         position, heading = _sigmas(covariance)
-        odometry = self.slam.filter.last_odometry if self.slam is not None else self.filter.last_odometry  # type: ignore[union-attr]
+        odometry = self.slam.odometry if self.slam is not None else self.filter.last_odometry  # type: ignore[union-attr]
         values: list[tuple[str, Any]] = [
             ("covariance", np.round(covariance, 9).tolist()),
             ("position_sigma_m", position), ("heading_sigma_deg", math.degrees(heading)),
@@ -190,7 +190,8 @@ class LocalisePose(BearingsBehaviour):
         if self.slam is not None:
             s = self.slam
             values += [("keyframes", len(s.keyframes)), ("loop_closures", len(s.loops)), ("frames", s.frames),
-                       ("found_per_frame", s.found / max(s.frames, 1)), ("culled", s.culled), ("merged", s.merged)]
+                       ("found_per_frame", s.found / max(s.frames, 1)), ("culled", s.culled), ("merged", s.merged),
+                       ("odometry_turn_scale", s.turns.scale)]
         values.append(("track", [*self.track]))
         yield from (Figure("exploration", f"localisation.{name}", value) for name, value in values)
 

@@ -9,5 +9,6 @@ AREAS = {
     "sim": "experiments.bench.sim",
     "perception": "experiments.bench.perception",
     "ltmap": "experiments.bench.ltmap",
+    "localisation": "experiments.bench.localisation",
     "sweep": "experiments.bench.sweep",
 }

@@ -23,6 +23,7 @@ module             what it holds
 ``keyframes``      a keyframe: the pose, the head, its features in the base frame
 ``loop``           recognising an old keyframe and the planar motion between the two (RANSAC)
 ``graph``          the pose graph over keyframes (scipy's least squares)
+``odometry``       odometry's turns calibrated against the cameras (for when they see nothing)
 ``slam``           :class:`~maps.slam.slam.StereoSlam`: the above, frame after frame
 =================  ==========================================================================
 

@@ -1,7 +1,8 @@
 """The stereo SLAM, frame after frame: :class:`StereoSlam`.
 
 Per tick, :meth:`StereoSlam.predict` moves the pose by the odometry increment (the prediction of
-:class:`maps.exploration.pose.PoseFilter`, with its odometry noise). Per stereo frame,
+:class:`maps.exploration.pose.PoseFilter`, with its odometry noise), its turn calibrated against the
+cameras (:mod:`maps.slam.odometry`). Per stereo frame,
 :meth:`StereoSlam.observe`:
 
 1. predicts every landmark's observation at the predicted pose and the frame's head angles, and
@@ -47,6 +48,7 @@ from maps.slam.graph import Edge, compose, optimise, relative, whitener
 from maps.slam.keyframes import Keyframe, KeyframePolicy, view_overlap, wants_keyframe
 from maps.slam.landmarks import LandmarkMap
 from maps.slam.loop import LoopClosure, find_loop
+from maps.slam.odometry import TurnCalibration, calibrated
 from maps.slam.tracking import refine_pose
 from maps.slam.viewpoint import Viewpoint
 from perception.camera import StereoRig
@@ -77,6 +79,7 @@ class SlamParams:
     loop_candidates: int = 6  # the closest this many are compared
     loop_min_inliers: int = 25
     covisible_min: int = 15  # landmarks shared with an older keyframe to join the two by an edge
+    calibration_gap: float = 0.5  # s: two corrections at most this far apart calibrate odometry's turns
     edge_sigma: tuple[float, float, float] = (0.01, 0.03, math.radians(0.3))  # consecutive keyframes:
     # m + per m driven (x, y), rad + per rad turned (theta) -- also per m driven, times 0.5 deg
     odometry: OdometryNoise = OdometryNoise()
@@ -109,6 +112,8 @@ class StereoSlam:
     edges: list[Edge] = field(default_factory=list)
     loops: list[LoopClosure] = field(default_factory=list)
     anchor: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))  # the tracked-against map's covariance
+    turns: TurnCalibration = TurnCalibration()
+    odometry: Pose2D | None = None  # the last raw odometry pose
     frames: int = 0
     found: int = 0  # landmarks found (used in updates), summed over the frames
     culled: int = 0
@@ -116,6 +121,9 @@ class StereoSlam:
 
     def __post_init__(self) -> None:
         self._rng = np.random.default_rng(self.seed)
+        self._calibrated = self.filter.last_odometry  # odometry with its turns calibrated
+        self.odometry = self.filter.last_odometry
+        self._last_fix: tuple[float, float, float] | None = None  # raw heading, estimate, stamp
 
     @classmethod
     def start(cls, odometry: Pose2D, head: StereoHead, params: SlamParams = SlamParams(), seed: int = 0) -> StereoSlam:
@@ -137,8 +145,12 @@ class StereoSlam:
         return self.filter.covariance[:3, :3]
 
     def predict(self, odometry: Pose2D) -> None:
-        """Move by the odometry increment since the last call."""
-        self.filter = self.filter.predict(odometry)
+        """Move by the odometry increment since the last call, its turn calibrated."""
+        if self.odometry is None or self._calibrated is None:
+            self.odometry = self._calibrated = odometry
+        self._calibrated = calibrated(self._calibrated, self.odometry, odometry, self.turns.scale)
+        self.odometry = odometry
+        self.filter = self.filter.predict(self._calibrated)
 
     # -- a frame ---------------------------------------------------------------------------------
     def observe(self, stereo: StereoPoints, rig: StereoRig, pan: float, tilt: float, stamp: float) -> FrameOutcome:
@@ -155,6 +167,7 @@ class StereoSlam:
                           max_distance=p.max_distance, ratio=p.ratio)
         rows, features = prediction.rows[pairs.landmark], pairs.feature
         used = np.zeros(len(rows), dtype=bool)
+        last_fix, self._last_fix = self._last_fix, None  # set again by a correction
         if len(rows) >= p.min_update:
             update = refine_pose(mean, cov, self.landmarks.positions[rows], self.landmarks.covariances[rows],
                                  observed[features], view, rig, sigma_px=p.sigma_px, huber=p.huber)
@@ -162,6 +175,7 @@ class StereoSlam:
             if used.sum() >= p.min_update:
                 mean, cov = update.mean, update.covariance
                 self._set_pose(mean, cov)
+                self._calibrate(last_fix, float(mean[2]), stamp)
             else:
                 used[:] = False
         self.landmarks.visible[prediction.rows] += 1
@@ -169,7 +183,7 @@ class StereoSlam:
         self.landmarks.found[rows] += 1
         self.found += len(rows)
         if len(rows):
-            self.anchor = self._anchor_covariance(self.landmarks.anchors[rows])
+            self.anchor = self._anchor_covariance(self.landmarks.anchors[rows], mean)
         self.landmarks.descriptors[rows] = descriptors[features]
         points, point_cov = self._world_points(stereo.points[features], observed[features], rig, view, mean, cov)
         self.landmarks.fuse(rows, points, point_cov, p.floor)
@@ -181,11 +195,24 @@ class StereoSlam:
             loop = self._keyframe(stereo, observed, descriptors, rows, features, rig, view, (pan, tilt), stamp)
         return FrameOutcome(len(stereo), len(prediction), len(pairs), len(rows), keyframe, loop)
 
-    def _anchor_covariance(self, anchors: np.ndarray) -> np.ndarray:
-        """The keyframes' covariances, weighted by how many of the found landmarks each anchors."""
+    def _calibrate(self, last: tuple[float, float, float] | None, heading: float, stamp: float) -> None:
+        """Pair this correction's heading change with odometry's since the ``last`` one (when recent)."""
+        raw = self.odometry.theta if self.odometry is not None else 0.0
+        self._last_fix = (raw, heading, stamp)
+        if last is not None and stamp - last[2] <= self.params.calibration_gap:
+            self.turns = self.turns.add(math.remainder(raw - last[0], 2 * math.pi),
+                                        math.remainder(heading - last[1], 2 * math.pi))
+
+    def _anchor_covariance(self, anchors: np.ndarray, mean: np.ndarray) -> np.ndarray:
+        """The covariance the anchor keyframes of the found landmarks pass on to a pose at ``mean``
+        (each keyframe's, compounded to the pose: its heading's uncertainty times the distance
+        becomes position uncertainty), weighted by how many of the landmarks each anchors."""
         keys, counts = np.unique(anchors, return_counts=True)
+        offset = mean[:2] - self.graph[keys, :2]  # from each keyframe to the pose
+        jac = np.broadcast_to(np.eye(3), (len(keys), 3, 3)).copy()  # d(K_k (+) rel) / d(K_k)
+        jac[:, 0, 2], jac[:, 1, 2] = -offset[:, 1], offset[:, 0]
         stacked = np.array([self.keyframes[int(k)].covariance for k in keys])
-        return np.einsum("k,kij->ij", counts / counts.sum(), stacked)
+        return np.einsum("k,kij->ij", counts / counts.sum(), jac @ stacked @ np.swapaxes(jac, 1, 2))
 
     def _set_pose(self, mean: np.ndarray, cov: np.ndarray) -> None:
         full = self.filter.mean.copy()
@@ -261,6 +288,7 @@ class StereoSlam:
         self.loops.append(loop)
         self.edges.append(Edge(loop.old, loop.new, loop.match.motion, whitener(loop.match.covariance)))
         self._solve()
+        self._last_fix = None  # the pose jumped: no heading change to compare
         self.anchor = self.keyframes[loop.old].covariance + loop.match.covariance
         self.keyframes[-1] = replace(frame, covariance=self.anchor)
         return loop
