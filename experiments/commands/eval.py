@@ -34,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Run an area's evaluation episodes through the sweep runner and print one JSON object of "
                     "named figures (--json) or a table. Works on any world file the simulator reads.",
         epilog="Areas and their --option names (an unknown name is refused with the list): exploration "
-               "(none; docs/exploration.md), ltmap (camera, route, min_landmarks, goal_tolerance, rotation; "
+               "(localisation; docs/exploration.md), ltmap (camera, route, min_landmarks, goal_tolerance, rotation; "
                "docs/ltmap.md), roadmap (targets, starts; docs/roadmap.md).",
     )
     parser.add_argument("area", choices=sorted(AREAS), help="what to evaluate")

@@ -10,7 +10,16 @@ import numpy as np
 import pytest
 
 from drivers.sim.world import load_world
-from experiments.eval.exploration import check_world, episode_figures, episodes, seen_floor, summarise_variant
+from experiments.eval.exploration import (
+    check_options,
+    check_world,
+    episode_figures,
+    episodes,
+    pose_errors,
+    seen_floor,
+    summarise_variant,
+    variant_of,
+)
 from maps.exploration.codec import pack_cells
 from maps.exploration.head import StereoHead, footprint
 from missions.cli import main
@@ -85,6 +94,36 @@ def test_three_variants_per_seed():
     runs = episodes("lab", [0, 1])
     assert len(runs) == 6 and {e.inputs["gaze"] for e in runs} == {"edges", "fixed"}
     assert {e.inputs["strategy"] for e in runs} == {"attraction", "closest_frontier"}
+    assert {e.inputs["localisation"] for e in runs} == {"stereo"}  # the visual localisation by default
+
+
+def test_the_localisation_option_names_the_oracle_beside_the_visual(tmp_path):
+    assert check_options("lab", {}) == ("visual",)
+    assert check_options("lab", {"localisation": "visual,ideal"}) == ("visual", "ideal")
+    with pytest.raises(ValueError, match="visual, ideal or visual,ideal"):
+        check_options("lab", {"localisation": "gps"})
+    stereo_only = tmp_path / "stereo_only.yaml"
+    stereo_only.write_text(Path(BOX).read_text() + "cameras:\n  - {name: stereo, kind: stereo, mount: ptu}\n")
+    assert check_options(str(stereo_only), {"localisation": "visual"}) == ("visual",)
+    with pytest.raises(ValueError, match="localisation ideal needs the camera 'landmarks'"):
+        check_options(str(stereo_only), {"localisation": "visual,ideal"})
+    runs = episodes("lab", [0], localisations=("visual", "ideal"))
+    assert len(runs) == 6 and sorted(variant_of(e.inputs) for e in runs) == [
+        "baseline", "baseline/ideal", "fixed", "fixed/ideal", "method", "method/ideal"]
+
+
+def test_the_pose_error_is_against_the_truth_in_the_start_frame():
+    # the robot starts at (1, 2) facing +y; the odometry frame's x axis is the world's +y
+    trajectory = [[0.0, 1.0, 2.0, math.pi / 2], [10.0, 1.0, 4.0, math.pi / 2]]
+    located = {"final_pose": {"x": 2.05, "y": 0.0, "theta": math.radians(1.0), "t": 10.0},
+               "track": [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0], [5.0, 1.0, 0.03, 0.0, 0.01, 0.001]],
+               "position_sigma_m": 0.02}
+    errors = pose_errors(report([], trajectory, localisation=located))
+    # the final pose is (2.05, 0) in the start frame: world (1, 4.05), 5 cm beyond the truth, 1 degree off
+    assert errors["pose_error_m"] == pytest.approx(0.05) and errors["heading_error_deg"] == pytest.approx(1.0)
+    assert errors["pose_error_max_m"] == pytest.approx(0.05) and errors["pose_ok"]
+    assert errors["pose_error_at_60s_m"] == pytest.approx(0.03)  # the last row by then: (1, 0.03) at 5 s
+    assert pose_errors(report([], trajectory)) == {}
 
 
 def test_the_command_refuses_an_open_world_and_bad_numbers(capsys):
