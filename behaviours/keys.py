@@ -1,6 +1,6 @@
 """The blackboard keys the framework itself reads or writes, outside any mission node.
 
-Namespaces follow DESIGN.md: ``/robot``, ``/ptu``, ``/perception``, ``/map``, ``/mission``. Node
+Namespaces follow docs/design.md: ``/robot``, ``/ptu``, ``/perception``, ``/map``, ``/mission``. Node
 types declare the keys they read and write as ports (:mod:`behaviours.ports`); this module lists
 only the framework's own ends of the data flow, which the loader's data-flow check adds to what
 the mission's nodes declare:
@@ -11,7 +11,11 @@ the mission's nodes declare:
   tick, so nodes can read inputs at run time (``{/mission/speed}``) as well as at load time
   (``${speed}``);
 - the data-gathering branch writes the sensed keys (its nodes' output ports,
-  :data:`behaviours.sense.SENSE_NODES`).
+  :data:`behaviours.sense.SENSE_NODES`); those the framework itself reads as well are declared
+  here (:data:`SENSED_KEYS`: the range sensors, which the collision monitor reads every tick);
+- the runner *writes* the collision monitor's verdict on the command it sent at the end of the
+  previous tick (:data:`RUNNER_KEYS`: ``/robot/safety``, clear before the first), so a behaviour
+  can tell that the robot is being slowed or stopped, and why.
 """
 
 from __future__ import annotations
@@ -20,6 +24,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from drivers.interfaces import PanTiltCommand, VelocityCommand
+from perception.collision_monitor import SafetyState
+from perception.ranges import RangeScan
 
 MISSION_NAMESPACE = "/mission"
 
@@ -37,6 +43,17 @@ COMMAND_KEYS = (
     KeySpec("/robot/command", VelocityCommand, "velocity for this tick; cleared before every tick"),
     KeySpec("/ptu/command", PanTiltCommand, "pan/tilt target; cleared before every tick"),
 )
+
+SAFETY_KEY = KeySpec("/robot/safety", SafetyState, "the collision monitor on the last command sent: clear, slowed "
+                     "or stopped, by which action and zone, and why")
+RUNNER_KEYS = (SAFETY_KEY,)
+"""Keys the runner writes every tick (besides the mission inputs)."""
+
+
+RANGES_KEY = KeySpec("/robot/ranges", RangeScan,
+                     "range sensors and bumpers around the base (sonar ring, bumpers), newest reading")
+SENSED_KEYS = (RANGES_KEY,)
+"""Sensed keys (written by the data-gathering branch only) that the framework reads too."""
 
 
 def input_key(name: str) -> str:

@@ -1,6 +1,6 @@
 """The LT-map on the blackboard: load it from a file, prune it to a memory budget.
 
-The map of a taught route (:class:`maps.ltmap.tree.LandmarkTree`, DESIGN.md algorithm 1) travels
+The map of a taught route (:class:`maps.ltmap.tree.LandmarkTree`, docs/design.md method 1) travels
 between nodes on ``/map/ltmap``: ``LearnRoute`` (:mod:`behaviours.teach`) or :class:`LoadMap`
 write it, :class:`PruneMap` shrinks it, the route-following nodes (:mod:`behaviours.route`,
 :mod:`behaviours.search`) read it. The file path is a literal port, so missions pass it as an
@@ -15,6 +15,7 @@ reached while following a pruned map with the place it was taught.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Iterator
 from typing import Any
 
@@ -22,13 +23,13 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.ports import READS, WRITES, InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.telemetry import Figure, section
 from maps.ltmap.file import load_ltmap, save_ltmap
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
 from maps.ltmap.tree import LandmarkTree, MapSummary
-from maps.store import InputError
+from maps.store import InputError, check_not_redirected
 
 LTMAP_KEY = "/map/ltmap"
 LTMAP_IN = InputPort("ltmap", LandmarkTree, Ref(LTMAP_KEY), doc="the LT-map of the taught route")
@@ -50,7 +51,10 @@ def summary_section(summary: MapSummary) -> dict[str, Any]:
 
 
 def save_map(path: str, tree: LandmarkTree) -> None:
-    """Save atomically (a failed save keeps the previous file): the one way the nodes write maps."""
+    """Save atomically (a failed save keeps the previous file): the one way the nodes write maps.
+    Never through a symbolic link put in the way since the mission was loaded (its path was checked
+    to lie in the output folder then)."""
+    check_not_redirected(path)
     save_ltmap(path, tree)
 
 
@@ -62,7 +66,8 @@ class LoadMap(BearingsBehaviour):
     the file is checked whole (version, checksum, tree consistency) before anything follows it.
     """
 
-    PATH = InputPort("path", str, doc="the LT-map file (a mission input: --set map=route.ltmap)", literal_only=True)
+    PATH = InputPort("path", str, doc="the LT-map file (a mission input: --set map=route.ltmap)", literal_only=True,
+                     file=READS)
     PORTS = (PATH, LTMAP_OUT)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
@@ -86,7 +91,8 @@ class LoadMap(BearingsBehaviour):
 
     def figures(self) -> Iterator[Figure]:
         if self.summary is not None:
-            yield from section("ltmap", {"map_file": self.get_input(self.PATH), **summary_section(self.summary)})
+            yield from section("ltmap", {"map_file": os.path.abspath(self.get_input(self.PATH)),
+                                         **summary_section(self.summary)})
 
 
 @register
@@ -105,7 +111,8 @@ class PruneMap(BearingsBehaviour):
                          doc="memory budget as a fraction of the map's size; 1: none")
     MIN_LANDMARKS = InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0,
                               doc="viewframes left with fewer landmarks are deleted (the paper: 50, enough for homing)")
-    PATH = InputPort("path", str, "", literal_only=True, doc="save the pruned map here too (empty: do not save)")
+    PATH = InputPort("path", str, "", literal_only=True, file=WRITES,
+                     doc="save the pruned map here too (empty: do not save)")
     SOURCE = InputPort("source", LandmarkTree, Ref(LTMAP_KEY), doc="the LT-map to prune")
     PORTS = (BUDGET, FRACTION, MIN_LANDMARKS, PATH, SOURCE, LTMAP_OUT)
 
@@ -148,7 +155,14 @@ class PruneMap(BearingsBehaviour):
                         "memory_fraction": round(after / before, 4) if before else 1.0,
                         "viewframe_source": source.tolist()}
         self.feedback_message = f"{before} -> {after} bytes, {pruned.viewframe_count} viewframes"
+        if budget is not None and before:
+            # whole tree levels are cut: the map lands on the nearest cut under the budget, often well under it
+            self.section["memory_fraction_asked"] = round(budget / before, 4)
+            self.feedback_message += (f" ({after / before:.1%} of the map for {budget / before:.1%} asked: pruning "
+                                      "cuts whole tree levels, this is the nearest cut under the budget)")
         return Status.SUCCESS
 
     def figures(self) -> Iterator[Figure]:
-        yield from section("ltmap", self.section)
+        asked = "memory_fraction_asked" in self.section  # a budget was given: say what it gave
+        shown = ("memory_fraction_asked", "memory_fraction") if asked else ()
+        yield from section("ltmap", self.section, headline=shown)

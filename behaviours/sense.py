@@ -14,10 +14,12 @@ from typing import Any
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour, NotSetUp
+from behaviours.keys import RANGES_KEY
 from behaviours.ports import OutputPort
 from drivers.interfaces import PanTiltState, Robot
 from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
+from perception.ranges import RangeScan
 
 
 class _Sensor(BearingsBehaviour):
@@ -56,6 +58,24 @@ class ReadPanTilt(_Sensor):
     def update(self) -> Status:
         if self.robot.ptu is not None:
             self.set_output(self.STATE, self.robot.ptu.state())
+        return Status.SUCCESS
+
+
+class ReadRanges(_Sensor):
+    """Copy the newest reading of the range sensors and bumpers to ``/robot/ranges``.
+
+    Writes nothing when the robot has no range source, or before its first reading (a sonar
+    ring that has not fired yet): readers take the key's absence as "no data".
+    """
+
+    RANGES = OutputPort("ranges", RangeScan, RANGES_KEY.path, doc=RANGES_KEY.doc)
+    PORTS = (RANGES,)
+
+    def update(self) -> Status:
+        source = self.robot.ranges
+        scan = source.read() if source is not None else None
+        if scan is not None:
+            self.set_output(self.RANGES, scan)
         return Status.SUCCESS
 
 
@@ -106,5 +126,5 @@ class GrabFrames(_Sensor):
         return Status.SUCCESS
 
 
-SENSE_NODES = (ReadOdometry, ReadPanTilt, GrabFrames)
+SENSE_NODES = (ReadOdometry, ReadRanges, ReadPanTilt, GrabFrames)
 """The runner's own data-gathering nodes, first in every tree."""

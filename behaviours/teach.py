@@ -16,6 +16,7 @@ turns those times into places with the simulator's ground-truth trajectory.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from typing import Any
 
@@ -26,7 +27,7 @@ from py_trees.common import Status
 from behaviours.base import BearingsDecorator
 from behaviours.landmark_tree import LTMAP_OUT, save_map, summary_section
 from behaviours.motion import ODOMETRY
-from behaviours.ports import InputPort, Ref
+from behaviours.ports import WRITES, InputPort, Ref
 from behaviours.registry import register
 from behaviours.telemetry import Drawing, Figure, Points, section
 from maps.ltmap.learner import LearnConfig, LearnStep, RouteLearner
@@ -45,7 +46,8 @@ class LearnRoute(BearingsDecorator):
     child fails (nothing saved), when nothing was observed, or when the file cannot be written.
     """
 
-    PATH = InputPort("path", str, "", literal_only=True, doc="the LT-map file written at the end; empty: not saved")
+    PATH = InputPort("path", str, "", literal_only=True, file=WRITES,
+                     doc="the LT-map file written at the end; empty: not saved")
     THRESHOLD = InputPort("threshold", float, DEFAULT_THRESHOLD, unit="rad^2", minimum=1e-9, literal_only=True,
                           doc="eq. 1: a new viewframe when delta_t passes it")
     BUDGET = InputPort("budget", int, 0, unit="B", minimum=0, literal_only=True,
@@ -134,8 +136,11 @@ class LearnRoute(BearingsDecorator):
         if tree is None:
             return
         taught = [{"viewframe": i, "time_s": t} for i, t in enumerate(self.taught)]
-        yield from section("ltmap", {**summary_section(tree.summary()), "map_file": self.get_input(self.PATH),
-                                     "saved": self.saved, "online_prunes": self.prunes, "taught": taught})
+        path = self.get_input(self.PATH)
+        written = os.path.abspath(path) if path else ""  # said at the end of the run: where the map went
+        yield from section("ltmap", {**summary_section(tree.summary()), "map_file": written, "saved": self.saved,
+                                     "online_prunes": self.prunes, "taught": taught},
+                           headline=("viewframes", "map_file"))
 
     def drawings(self) -> Iterator[Drawing]:
         """The viewframes made so far, where odometry put them (when there are new ones)."""

@@ -13,6 +13,7 @@ from typing import Protocol, runtime_checkable
 
 from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
+from perception.ranges import RangeScan
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,6 +101,17 @@ class Camera(Protocol):
 
 
 @runtime_checkable
+class RangeSource(Protocol):
+    """Range sensors and bumpers around the base (a sonar ring, the simulator's model of one)."""
+
+    def read(self) -> RangeScan | None:
+        """The newest reading of every sensor and bumper, or None before the first."""
+
+    def close(self) -> None:
+        """Release the device."""
+
+
+@runtime_checkable
 class KeySource(Protocol):
     """Keys typed by an operator (teleoperation); ``read`` never blocks."""
 
@@ -123,6 +135,7 @@ class Robot:
     base: Base
     ptu: PanTilt | None = None
     cameras: dict[str, Camera] = field(default_factory=dict)
+    ranges: RangeSource | None = None
     name: str = "robot"
 
     def missing_cameras(self, names: Iterable[str]) -> list[str]:
@@ -138,9 +151,9 @@ class Robot:
                 stop()
 
     def close(self) -> None:
-        """Stop, then release every device (cameras, pan-tilt, base last)."""
+        """Stop, then release every device (cameras, range sensors, pan-tilt, base last)."""
         self.stop_all()
-        devices = [*self.cameras.values(), self.ptu, self.base]
+        devices = [*self.cameras.values(), self.ranges, self.ptu, self.base]
         for device in devices:
             if device is None:
                 continue

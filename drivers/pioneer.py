@@ -27,6 +27,18 @@ Faults (see also :mod:`drivers.common`):
   ``atexit`` hook.
 - no ``drive()`` call for ``command_timeout`` while moving (a stuck tick loop): the thread
   commands zero velocity itself; the next ``drive()`` resumes (``deadman_stops`` counts these).
+- a pressed bumper: the SIP that carries it stops a command that moves towards it at once, from
+  the I/O thread (STOP, VEL 0, RVEL 0; ``bumper_stops`` counts these), as ARIA's bumpers action
+  does, without waiting for the next tick; while it stays pressed, ``drive()`` refuses motion
+  towards it (motion away, or a turn, passes).
+
+Sensing: ``range_source()`` is the robot's :class:`~drivers.interfaces.RangeSource` for the
+collision monitor: the sonar ring with the geometry of the model the robot reports and the
+bumpers (:mod:`drivers.pioneer_body`, from ARIA's parameter files); a transducer not heard for
+``sonar_timeout`` reads as no data.
+- the process dies without closing the base (``kill -9``, a crash, a plugin's ``os._exit``):
+  with ``guard`` (the default) a guard process holding a copy of the link stops the robot and
+  CLOSEs the session at once (:mod:`drivers.link_guard`); the firmware watchdog is the last net.
 
 The odometry frame starts at the pose of the first SIP (0, 0, 0) and stays continuous across
 the robot's 15-bit position wrap-around and across reconnections. The measured turn rate is the
@@ -52,8 +64,11 @@ from drivers import arcos
 from drivers.arcos import Command, Identity, ModelParams, Odometry, RobotConfig, Sip
 from drivers.arcos_port import ArcosPort
 from drivers.common import DriverFault, Stamp, build_settings, monotonic_stamp
+from drivers.link_guard import LinkGuard
+from drivers.pioneer_body import BODIES, PioneerBody, PioneerRanges
 from drivers.pioneer_settings import ModelChoice, PioneerSettings, choose_model
 from perception.geometry import Pose2D, wrap_angle
+from perception.ranges import RangeScan
 
 log = logging.getLogger(__name__)
 
@@ -77,6 +92,7 @@ class BaseStatus:
     motors_enabled: bool = False
     estop: bool = False
     sonar: tuple[tuple[int, float], ...] = ()  # (index, range m), every sonar seen so far
+    silent_sonar: frozenset[int] = frozenset()  # indices not heard for sonar_timeout
     sips: int = 0
     stamp: float = 0.0
 
@@ -112,12 +128,14 @@ class PioneerBase:
         self.reconnects = 0
         self.deadman_stops = 0
         self.clamped_commands = 0
+        self.bumper_stops = 0
         self.link_down: str | None = None  # reason while a reconnection is being attempted
         self._stamp = monotonic_stamp(clock)
         self._link = ArcosPort(settings.port, port_factory or serial.serial_for_url)
         self._odometry: Odometry | None = None
         self._status: BaseStatus | None = None
         self._sonar: dict[int, float] = {}
+        self._sonar_heard: dict[int, float] = {}  # index -> time.monotonic() of its last reading
         self._sips = 0  # SIPs decoded since the base was built
         self._target = (0.0, 0.0)  # mm/s, deg/s
         self._wake = threading.Event()
@@ -126,6 +144,7 @@ class PioneerBase:
         self._last_drive = time.monotonic()
         self._last_sip = time.monotonic()
         self._closed = False
+        self._guard: LinkGuard | None = None
 
     # -- the Base interface ----------------------------------------------------------------------
     def drive(self, v: float, w: float) -> None:
@@ -141,6 +160,9 @@ class PioneerBase:
         self._last_drive = time.monotonic()
         if self.link_down is not None:
             return  # reconnecting: the robot is stopped; the next drive() after it resumes
+        status = self._status
+        if status is not None and _towards_pressed_bumper(status, mm_s):
+            mm_s = deg_s = 0.0  # the bumper stays pressed: no motion towards it
         target = (mm_s, deg_s)
         if target != self._target:
             self._target = target
@@ -218,6 +240,22 @@ class PioneerBase:
         """Newest range (m) of every sonar seen so far, by index."""
         return dict(self._current().sonar)
 
+    def body(self) -> PioneerBody:
+        """Footprint, sonar ring and bumpers of the model in use (a P3-DX's before the robot has said)."""
+        return BODIES[self.model.params.name if self.model is not None else "p3dx"]
+
+    def range_scan(self) -> RangeScan:
+        """The newest SIP's sonar readings and bumpers as one scan, stamped when the SIP arrived."""
+        status = self._current()
+        return self.body().scan(dict(status.sonar), status.silent_sonar, status.front_bumpers, status.rear_bumpers,
+                                status.stamp, with_sonar=self.settings.sonar)
+
+    def range_source(self) -> PioneerRanges:
+        """This base's sonar ring and bumpers as the robot's range source."""
+        sensors = f"{len(self.body().sonar)} sonars and " if self.settings.sonar else ""
+        return PioneerRanges(self.range_scan, f"pioneer {self.body().model}: {sensors}"
+                             f"{self.body().front_bumpers + self.body().rear_bumpers} bumpers")
+
     def limits(self) -> tuple[float, float]:
         """``(max forward speed m/s, max turn rate deg/s)`` the driver clamps commands to."""
         params = self.params or arcos.MODELS["p3at"]  # the slower model until the robot has said
@@ -265,6 +303,15 @@ class PioneerBase:
         self._send(arcos.encode_command(Command.ENABLE, 1))
         self._send_velocity()
         self._await_first_sip(deadline)
+        self._start_guard()
+
+    def _start_guard(self) -> None:
+        """A process that stops the robot if this one dies with the session open (drivers/link_guard.py)."""
+        fd = self._link.fileno() if self.settings.guard else None
+        if fd is not None:
+            farewell = (arcos.encode_command(Command.STOP) + arcos.encode_vel(0) + arcos.encode_rvel(0)
+                        + arcos.encode_command(Command.ENABLE, 0) + arcos.encode_command(Command.CLOSE))
+            self._guard = LinkGuard.start(fd, farewell)
 
     def _open_port(self) -> None:
         self._link.open(self.settings.baud)
@@ -411,8 +458,11 @@ class PioneerBase:
         if self._odometry is None:
             self._odometry = Odometry(params)
         x, y, theta = self._odometry.update(sip)
+        heard = time.monotonic()
         for index, raw in sip.sonar:
             self._sonar[index] = raw * params.range_conv / 1000.0
+            self._sonar_heard[index] = heard
+        silent = frozenset(i for i, t in self._sonar_heard.items() if heard - t > self.settings.sonar_timeout)
         v, w = arcos.measured_velocity(sip, params)
         stamp = self._stamp()
         self._status = BaseStatus(
@@ -427,11 +477,21 @@ class PioneerBase:
             motors_enabled=sip.motors_enabled,
             estop=sip.estop,
             sonar=tuple(sorted(self._sonar.items())),
+            silent_sonar=silent,
             sips=self._sips + 1,
             stamp=stamp,
         )
         self._sips += 1
         self._last_sip = time.monotonic()
+        if _towards_pressed_bumper(self._status, self._target[0]):
+            self._bumper_stop()
+
+    def _bumper_stop(self) -> None:
+        """A bumper pressed in the direction of motion: stop now, from the thread that read the SIP."""
+        self._target = (0.0, 0.0)
+        self.bumper_stops += 1
+        log.warning("Pioneer on %s: bumper pressed while moving towards it; stopped", self.settings.port)
+        self._send_stop()
 
     def _recover(self, reason: str) -> bool:
         """After a lost link: stop, then reconnect if allowed; False when the thread must end."""
@@ -493,6 +553,9 @@ class PioneerBase:
         time.sleep(seconds)
 
     def _release_port(self) -> None:
+        guard, self._guard = self._guard, None
+        if guard is not None:
+            guard.release()
         self._link.release()
         if self._odometry is not None:
             self._odometry.restart()
@@ -512,6 +575,11 @@ class PioneerBase:
         if status is None:
             raise DriverFault("the Pioneer base is not connected")
         return status
+
+
+def _towards_pressed_bumper(status: BaseStatus, mm_s: float) -> bool:
+    """Does forward speed ``mm_s`` move towards a pressed bumper (front: forward, rear: backward)?"""
+    return (mm_s > 0 and status.front_bumpers != 0) or (mm_s < 0 and status.rear_bumpers != 0)
 
 
 def open_base(settings: PioneerSettings | Mapping[str, Any] | None = None, /, *, clock: Stamp | None = None,

@@ -3,8 +3,9 @@
 Run by the loader on a mission whose nodes are already valid one by one. Writers of a key are:
 the output ports of the mission's nodes (as remapped), the data-gathering branch's own nodes
 (:data:`behaviours.sense.SENSE_NODES`), and the runner, which publishes every mission input as
-``/mission/<input>``. Readers are input ports given a ``{/ns/key}`` reference (their default
-included) and literal ``key`` inputs (``Guard``, ``CheckBlackboard``). The runner itself reads
+``/mission/<input>`` and the collision monitor's state (:data:`behaviours.keys.RUNNER_KEYS`, a
+key with one writer, like a sensed one). Readers are input ports given a ``{/ns/key}``
+reference (their default included) and literal ``key`` inputs (``Guard``, ``CheckBlackboard``). The runner itself reads
 the command keys (:data:`behaviours.keys.COMMAND_KEYS`). Rules:
 
 1. every key read has at least one writer (a did-you-mean names the closest written key);
@@ -23,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from behaviours.keys import COMMAND_KEYS, input_key
+from behaviours.keys import COMMAND_KEYS, RUNNER_KEYS, input_key
 from behaviours.ports import InputPort, Key, Ref, assignable, attribute_type, type_name
 from behaviours.registry import NodeType
 from behaviours.sense import SENSE_NODES
@@ -74,6 +75,8 @@ def _writers(mission: MissionSpec) -> dict[str, list[Writer]]:
     for name, declared in mission.inputs.items():
         key = input_key(name)
         out.setdefault(key, []).append(Writer(key, declared.type, f"the mission input {name!r}", here))
+    for spec in RUNNER_KEYS:
+        out.setdefault(spec.path, []).append(Writer(spec.path, spec.type, "the runner", here, True))
     for sensed, roots in ((True, mission.sense), (False, (mission.tree,))):
         for spec in (node for root in roots for node in root.walk()):
             node_type = mission.registry.lookup(spec.type)

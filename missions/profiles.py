@@ -7,13 +7,17 @@ A profile names a driver for the base, optionally the pan-tilt unit and cameras:
     ptu: {driver: ptu_d46, port: /dev/ttyUSB1}
     cameras:
       omni: {driver: opencv, device: 0, calibration: omni.yaml}
+    safety: {stop_margin: 0.15}   # the collision monitor (optional; docs/hardware.md)
 
 The profile's shape is the declared model :class:`RobotProfile`; each device's settings are the
 declared model of its driver: the type of the ``settings`` argument of the driver's opener
 (``open_base(settings: PioneerSettings)``), so a driver declares its settings (units, ranges)
 once, where it is written. Both are checked with located errors (:mod:`maps.located`), like
 missions and worlds. Nothing is opened until the whole profile is valid, and a device that fails
-to open closes the ones already open.
+to open closes the ones already open. A base that offers ``range_source()`` (the Pioneer: its
+sonar ring and bumpers) becomes the robot's :class:`~drivers.interfaces.RangeSource`, and
+:func:`robot_safety` builds the collision monitor's configuration from the ``safety:`` section over
+the footprint of the model the base reports (``body()``).
 """
 
 from __future__ import annotations
@@ -31,9 +35,12 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
 from behaviours.ports import Ref
 from drivers.interfaces import Robot
+from drivers.pioneer_body import BODIES
+from drivers.safety.settings import SafetySettings, monitor_config
 from maps.located import FILE_MODEL_CONFIG, diagnose, suggest, validate
 from maps.store import Diagnostic, InputError, YamlMap, load_yaml
 from missions.language import MissionSpec
+from perception.collision_monitor import MonitorConfig
 
 PROFILES = Path(__file__).resolve().parent.parent / "drivers" / "profiles"
 Role = Literal["base", "ptu", "camera"]
@@ -64,6 +71,8 @@ class RobotProfile(BaseModel):
     base: DeviceEntry = Field(description="the differential-drive base")
     ptu: DeviceEntry | None = Field(None, description="the pan-tilt unit, if any")
     cameras: dict[str, DeviceEntry] = Field(default_factory=dict, max_length=32, description="cameras by name")
+    safety: SafetySettings | None = Field(None, description="the collision monitor: footprint, zones, limits "
+                                          "(default: the footprint of the model the base reports)")
 
 
 @dataclass(frozen=True)
@@ -184,12 +193,31 @@ def open_robot(path: str | Path, *, clock: Callable[[], float] | None = None) ->
                 ptu = handle
             else:
                 cameras[device.name] = handle
-        return Robot(base=base, ptu=ptu, cameras=cameras, name=name)  # type: ignore[arg-type]
+        source = getattr(base, "range_source", None)
+        ranges = source() if callable(source) else None
+        return Robot(base=base, ptu=ptu, cameras=cameras, ranges=ranges, name=name)  # type: ignore[arg-type]
     except BaseException:
         for handle in reversed(opened):
             with contextlib.suppress(Exception):  # already failing; close the rest
                 handle.close()
         raise
+
+
+def robot_safety(path: str | Path, robot: Robot) -> MonitorConfig:
+    """The collision monitor of a robot opened from the profile at ``path``: its ``safety:`` section
+    over the footprint of the model the base reports (``body()``; a P3-DX's for a base that does
+    not say). :class:`InputError` located at the section when a zone leaves the footprint out."""
+    file = str(path)
+    doc = load_yaml(path)
+    profile = validate(RobotProfile, doc, file=file)
+    body = getattr(robot.base, "body", None)
+    footprint = body().footprint if callable(body) else BODIES["p3dx"].footprint
+    try:
+        return monitor_config(profile.safety, footprint)
+    except ValueError as exc:
+        mark = doc.value_mark_of("safety") if isinstance(doc, YamlMap) and "safety" in doc else None
+        line, col = (mark.line, mark.col) if mark is not None else (0, 0)
+        raise InputError([Diagnostic(file, line, col, str(exc))]) from None
 
 
 def profile_schema() -> dict[str, Any]:

@@ -24,6 +24,20 @@ SIGINT / SIGTERM           INTERRUPTED  130 / 143, even while a behaviour blocks
 In every case the base and the pan-tilt unit are commanded to stop before any driver closes,
 and the last command recorded (report and recording) is a zero velocity.
 
+The collision monitor sits between the tree and the base on every run: the runner wraps
+``robot.base`` in a :class:`~drivers.safety.guarded_base.GuardedBase` before the tree is set up,
+so every command (the tree's, or a node's own call to the base) is limited against the robot's
+range source (``robot.ranges``) with the footprint and zones of ``safety`` (a
+:class:`~perception.collision_monitor.MonitorConfig`; default: a Pioneer 3-DX's). After each
+tick ``/robot/safety`` holds the monitor's state, the recording gets an event line per
+intervention, and the report a ``safety`` section (stops and slow-downs counted as episodes,
+bumper hits, the nearest range, the first events).
+
+With ``record_path`` (``--record``) every device of the robot records what it delivers and what
+it is sent (:class:`~drivers.logs.record.SensorLog`, inside the collision monitor: the base's
+commands are the ones sent), the tree's own command and the clock once per tick; the file is
+closed on every way the run ends and the report gets a ``record`` section.
+
 Capabilities add to the report and the recording without touching the runner: any node of the
 tree may report ``figures()`` (named values, gathered into the report's sections: ``ltmap``,
 ``roadmap``, ``exploration``; numbers are plotted in the recording too) and ``drawings()``
@@ -37,6 +51,7 @@ used, and where they came from). Behaviours still never see ground truth: the si
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 import sys
 import time
@@ -44,22 +59,32 @@ import traceback
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import py_trees
 from py_trees.common import Status
 
 from behaviours.clock import TickClock
-from behaviours.keys import COMMAND_KEYS, input_key
-from behaviours.telemetry import Draws, Reports, Sections
+from behaviours.keys import COMMAND_KEYS, SAFETY_KEY, input_key
+from behaviours.telemetry import Draws, Event, Plot, Reports, Sections
 from drivers.interfaces import STOP, KeyboardOpener, PanTiltCommand, Robot, VelocityCommand
 from drivers.keyboard import TerminalKeys
+from drivers.logs.camera_codec import ImageFormat
+from drivers.pioneer_body import BODIES
+from drivers.safety.guarded_base import GuardedBase
+from drivers.safety.settings import monitor_config
 from maps.store import write_json
 from missions.builder import build_root
 from missions.clocks import WallClock
+from missions.images import DEFAULT_RATE_HZ
 from missions.language import MissionSpec
 from missions.recording import Recorder
 from missions.safety import Interrupted, SafetyMonitor, exit_code
+from missions.summary import declared_headline
+from perception.collision_monitor import CollisionMonitor, MonitorConfig
+
+if TYPE_CHECKING:
+    from drivers.logs.record import SensorLog
 
 
 class RunObserver(Protocol):
@@ -79,9 +104,11 @@ class RunOptions:
     overrun_s: float | None = None  # tick watchdog limit; None: the mission's on a robot, none in simulation
     report_path: Path | None = None
     save_path: Path | None = None
-    progress: bool = False
+    image_rate_hz: float | None = DEFAULT_RATE_HZ  # camera images per second in the recording; None or 0: every frame
     seed: int = 0
     debug: bool = False  # print the traceback of an exception in the tree
+    record_path: Path | None = None  # --record: every sensed input and command, as ROS 2 messages in MCAP
+    record_images: ImageFormat = field(default_factory=ImageFormat)
 
 
 @dataclass
@@ -115,12 +142,22 @@ class Runner:
         observers: Sequence[RunObserver] = (),
         on_tick: Callable[[Runner], None] | None = None,
         keyboard: KeyboardOpener = TerminalKeys,
+        safety: MonitorConfig | None = None,
     ) -> None:
         self.mission = mission
-        self.robot = robot
-        self.keyboard = keyboard  # opened by a node that drives by keys, when it first runs
         self.options = options or RunOptions()
         self.clock: TickClock = clock or WallClock()
+        self.sensor_log: SensorLog | None = None
+        if self.options.record_path is not None:  # devices record what they deliver and are sent, inside the monitor
+            from drivers.logs.record import SensorLog  # MCAP's libraries load only when a run records
+
+            self.sensor_log = SensorLog(self.options.record_path, images=self.options.record_images)
+            robot = self.sensor_log.wrap(robot, self.clock.now)
+            keyboard = self.sensor_log.wrap_keyboard(keyboard)
+        self.keyboard = keyboard  # opened by a node that drives by keys, when it first runs
+        config = safety or monitor_config(None, BODIES["p3dx"].footprint)
+        self.guard = GuardedBase(robot.base, CollisionMonitor(config), robot.ranges, self.clock.now)
+        self.robot = dataclasses.replace(robot, base=self.guard)  # the tree and the stops see the guarded base
         self.observers = tuple(observers)
         self.on_tick = on_tick
         self.rate_hz = self.options.rate_hz or mission.rate_hz
@@ -137,7 +174,7 @@ class Runner:
         self.tree.add_pre_tick_handler(self._clear_commands)
         self.tree.add_post_tick_handler(self._dispatch)
         self.blackboard = py_trees.blackboard.Client(name="runner")
-        for spec in COMMAND_KEYS:
+        for spec in (*COMMAND_KEYS, SAFETY_KEY):
             self.blackboard.register_key(key=spec.path, access=py_trees.common.Access.WRITE)
         overrun = self.options.overrun_s
         if overrun is None and self.clock.timeline == "wall_time":
@@ -177,15 +214,17 @@ class Runner:
         if self.options.save_path is not None:
             self._recorder = Recorder(self.options.save_path, mission=self.mission.name,
                                       recording_id=f"{self.mission.name}-seed{self.options.seed}",
-                                      timeline=self.clock.timeline)
+                                      timeline=self.clock.timeline, image_rate_hz=self.options.image_rate_hz)
+        if self.sensor_log is not None:
+            self.sensor_log.open(mission=self.mission.name, timeline=self.clock.timeline, rate_hz=self.rate_hz)
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
+        self.blackboard.set(SAFETY_KEY.path, self.guard.state)
         # hand every node the clock and the drivers (the keyboard as an opener: a terminal is taken only if used)
         self.tree.setup(clock=self.clock, robot=self.robot, keyboard=self.keyboard)
         self._drawers = [node for node in self.root.iterate() if isinstance(node, Reports | Draws)]
 
     def _loop(self) -> tuple[str, str]:
-        last_progress = 0.0
         while True:
             stop = self.monitor.stopped_reason
             if stop is not None:
@@ -202,9 +241,6 @@ class Runner:
                 return "FAILURE", self.monitor.fault
             if self.on_tick is not None:
                 self.on_tick(self)
-            if self.options.progress and time.monotonic() - last_progress > 0.2:
-                last_progress = time.monotonic()
-                self._print_progress(now)
             if self.root.status in (Status.SUCCESS, Status.FAILURE):
                 return self.root.status.value, self._outcome_reason()
             self.clock.next_tick(self.period)
@@ -213,6 +249,8 @@ class Runner:
         """Stop everything, halt the tree, record the stop (runs whatever happened)."""
         self.robot.stop_all()  # the last command sent is always a stop
         self.last_command = STOP
+        if self.sensor_log is not None:
+            self.sensor_log.close()
         with contextlib.suppress(Exception):  # halting must not mask the outcome
             if self.root.status == Status.RUNNING:
                 self.root.stop(Status.INVALID)
@@ -220,19 +258,23 @@ class Runner:
             with contextlib.suppress(Exception):  # the run's outcome matters more than the file
                 self._recorder.log_stop(time_s=self.clock.now(), tick=self.ticks)
                 self._recorder.close()
-        if self.options.progress:
-            sys.stderr.write("\n")
 
     def _result(self, status: str, reason: str) -> RunResult:
         result = RunResult(status, reason, self.ticks, self.clock.now(), signum=self.monitor.signum)
         result.report = self._report(result)
         if self.options.report_path is not None:
-            write_json(self.options.report_path, result.report)
+            try:
+                write_json(self.options.report_path, result.report)
+            except OSError as exc:  # a full disk must not turn the run's outcome into a traceback
+                sys.stderr.write(f"bearings run: the report was not written to {self.options.report_path}: "
+                                 f"{exc.strerror or exc}; the run ended {status} ({reason})\n")
         return result
 
     def _emergency_exit(self, signum: int) -> None:
         """Called by the monitor when a signal came and the loop is stuck: report, then end the process."""
         self.robot.stop_all()
+        if self.sensor_log is not None:
+            self.sensor_log.close()
         with contextlib.suppress(Exception):
             reason = f"{self.monitor.stopped_reason}; the tree did not return, the process was ended"
             self._result("INTERRUPTED", reason)
@@ -251,8 +293,12 @@ class Runner:
         if self.monitor.stopped_reason is not None:
             return  # the monitor stopped the base: the tree's command must not restart it
         command = self._get("/robot/command")
-        self.last_command = command if isinstance(command, VelocityCommand) else STOP
-        self.robot.base.drive(self.last_command.v, self.last_command.w)
+        asked = command if isinstance(command, VelocityCommand) else STOP
+        self.robot.base.drive(asked.v, asked.w)  # through the collision monitor
+        self.last_command = VelocityCommand(asked.v * self.guard.state.ratio, asked.w * self.guard.state.ratio)
+        self.blackboard.set(SAFETY_KEY.path, self.guard.state)
+        if self.sensor_log is not None:
+            self.sensor_log.tick(asked)
         ptu_command = self._get("/ptu/command")
         if self.robot.ptu is not None and isinstance(ptu_command, PanTiltCommand) and ptu_command != self._last_ptu:
             self.robot.ptu.move(ptu_command.pan, ptu_command.tilt, ptu_command.speed)
@@ -260,7 +306,11 @@ class Runner:
         if self._recorder is not None:
             self._recorder.log_tick(time_s=self.clock.now(), tick=self.ticks + 1, root=self.root,
                                     odometry=self._get("/robot/odometry"), command=self.last_command,
-                                    observers=self.observers, nodes=self._drawers)
+                                    observers=self.observers, nodes=self._drawers,
+                                    frames=self._get("/perception/frames"))
+            self._recorder.draw(Plot("safety/ratio", self.guard.state.ratio))
+            for event in self.guard.log.take_new():
+                self._recorder.draw(Event("safety/events", event.line()))
 
     # -- helpers ---------------------------------------------------------------------------------
     def _get(self, key: str) -> Any:
@@ -269,7 +319,7 @@ class Runner:
         except KeyError:
             return None
 
-    def _node_sections(self) -> dict[str, dict[str, Any]]:
+    def _node_sections(self) -> Sections:
         """What the tree's nodes add to the report (a node that fails to say is noted, not fatal)."""
         gathered = Sections()
         for node in self.root.iterate():
@@ -278,7 +328,7 @@ class Runner:
                     gathered.add(node.figures())
             except Exception as exc:  # noqa: BLE001 - the report must be written whatever a node does
                 gathered.sections.setdefault("report_errors", {})[node.name] = describe_exception(exc)
-        return gathered.sections
+        return gathered
 
     def _outcome_reason(self) -> str:
         if self.root.status == Status.SUCCESS:
@@ -290,13 +340,6 @@ class Runner:
             detail = f": {node.feedback_message}" if node.feedback_message else ""
             return f"{node.name} failed{detail}"
         return "mission tree failed"
-
-    def _print_progress(self, now: float) -> None:
-        tip = self.task.tip()
-        active = "" if tip is None else tip.name + (f": {tip.feedback_message}" if tip.feedback_message else "")
-        line = f"[{self.mission.name}] t={now:7.1f} s  tick {self.ticks:6d}  {active}"
-        sys.stderr.write("\r" + line[:110].ljust(110))
-        sys.stderr.flush()
 
     def _report(self, result: RunResult) -> dict[str, Any]:
         mission = self.mission
@@ -316,12 +359,17 @@ class Runner:
             report["sim_time_s"] = round(result.time_s, 6)
         for observer in self.observers:
             report.update(observer.report_sections(mission.evaluation))
-        for name, values in self._node_sections().items():
+        nodes = self._node_sections()
+        for name, values in nodes.sections.items():
             report.setdefault(name, {}).update(values)
-        for device in (self.robot.base, self.robot.ptu):
+        report["safety"] = self.guard.log.summary()
+        if self.sensor_log is not None:
+            report["record"] = self.sensor_log.summary()
+        for device in (self.guard.base, self.robot.ptu):
             sections = getattr(device, "report_sections", None)
             if callable(sections):
                 report.update(sections())
+        report["headline"] = declared_headline([*self.observers, self.robot.base, self.robot.ptu], nodes.headline)
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}

@@ -58,7 +58,7 @@ class LocalisePose(BearingsBehaviour):
     theta, sigma of the position, sigma of the heading).
     """
 
-    CAMERA = InputPort("camera", str, "stereo", literal_only=True,
+    CAMERA = InputPort("camera", str, "stereo", literal_only=True, camera=True,
                        doc="the camera the pose is corrected with: a stereo pair (visual SLAM on its features) or a "
                            "bearings sensor of identified landmarks (the simulator's ideal 'landmarks')")
     MOUNT = InputPort("mount", list[float], [0.0, 0.0, 0.0], unit="m, m, deg", literal_only=True,

@@ -1,8 +1,13 @@
 """The world as flat arrays for fast geometry: ray casting, occlusion, collision, texture layout.
 
-Walls and box faces become line segments, pillars circles; each surface knows where its texture
-sits in the atlas. Everything here is vectorised over rays and surfaces with numpy, so one
+Walls and box faces become line segments, pillars and people circles; each surface knows where its
+texture sits in the atlas. Everything here is vectorised over rays and surfaces with numpy, so one
 panorama's 720 column rays against a few dozen surfaces cost a handful of array operations.
+
+People are the scene's only moving surfaces: circles after the pillars whose centres the
+simulation moves each step (:meth:`Scene.move_people`), so every camera, the bearings sensor's
+occlusion and the sonar see them where they are now. :meth:`Scene.clearance` (collisions, free
+space) holds the fixed surfaces only; the simulation adds the people itself.
 """
 
 from __future__ import annotations
@@ -12,8 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drivers.sim.people import position_at
 from drivers.sim.textures import AtlasBuilder, Region, make_sky, make_texture
-from drivers.sim.world_values import TextureSpec, World
+from drivers.sim.world_values import Person, Pillar, TextureSpec, World
 from perception.geometry import Pose2D
 
 EPS = 1e-9
@@ -51,10 +57,11 @@ class Scene:
             heights += [wall.height] * n
             ppm += [wall.texture.pixels_per_m] * n
         n_segments = len(heights)
-        for pillar in world.pillars:
-            heights.append(pillar.height)
-            ppm.append(pillar.texture.pixels_per_m)
-        # surfaces: every wall/box segment, then every pillar
+        rounds: list[Pillar | Person] = [*world.pillars, *world.people]  # the vertical cylinders
+        for round_surface in rounds:
+            heights.append(round_surface.height)
+            ppm.append(round_surface.texture.pixels_per_m)
+        # surfaces: every wall/box segment, then every pillar, then every person
         self.n_surfaces = len(heights)
         self.n_segments = n_segments
         self.heights = np.asarray(heights, dtype=float)
@@ -66,9 +73,10 @@ class Scene:
         self._seg_offset = np.concatenate(offsets) if offsets else np.zeros(0)
         self._seg_e = self.seg_b - self.seg_a
         self.seg_len = np.hypot(self._seg_e[:, 0], self._seg_e[:, 1])
-        self.circle_xy = np.asarray([(p.x, p.y) for p in world.pillars], dtype=float).reshape(-1, 2)
-        self.circle_r = np.asarray([p.radius for p in world.pillars], dtype=float)
-        self.circle_h = np.asarray([p.height for p in world.pillars], dtype=float)
+        self.n_pillars = len(world.pillars)
+        centres = [*((p.x, p.y) for p in world.pillars), *(position_at(p, 0.0) for p in world.people)]
+        self.circle_xy = np.asarray(centres, dtype=float).reshape(-1, 2)
+        self.circle_r = np.asarray([p.radius for p in rounds], dtype=float)
         self._pillar_index = np.arange(n_segments, self.n_surfaces)
         self.landmark_ids = np.asarray([lm.id for lm in world.landmarks], dtype=np.int64)
         self.landmark_xyz = np.asarray([(lm.x, lm.y, lm.z) for lm in world.landmarks], dtype=float).reshape(-1, 3)
@@ -87,8 +95,10 @@ class Scene:
             length = float(np.sum(np.linalg.norm(np.diff(np.asarray(wall.points), axis=0), axis=1)))
             index = builder.add(_surface_texture(wall.texture, length, wall.height))
             tex_index += [index] * (len(wall.points) - 1)
-        for pillar in world.pillars:
-            tex_index.append(builder.add(_surface_texture(pillar.texture, 2 * math.pi * pillar.radius, pillar.height)))
+        rounds: list[Pillar | Person] = [*world.pillars, *world.people]
+        for round_surface in rounds:
+            tex_index.append(builder.add(_surface_texture(
+                round_surface.texture, 2 * math.pi * round_surface.radius, round_surface.height)))
         ground = self._add_ground(builder)
         sky_idx, sky_w, sky_h = self._add_sky(builder)
         atlas, origins = builder.build()
@@ -247,7 +257,7 @@ class Scene:
     # Occlusion and collision
 
     def occluded(self, eye: np.ndarray, points: np.ndarray, margin: float = 0.02) -> np.ndarray:
-        """Whether walls, box faces or pillars block the straight line from ``eye`` to each point.
+        """Whether walls, box faces, pillars or people block the straight line from ``eye`` to each point.
 
         A surface hides a point when the line of sight crosses it (in plan) between the eye and
         the point, at a height between the floor and the surface's top. Surfaces closer than
@@ -279,16 +289,71 @@ class Scene:
         return hit.any(axis=1)
 
     def clearance(self, x: float, y: float) -> float:
-        """Distance (m) from (x, y) to the nearest wall, box face or pillar surface (inf: none)."""
+        """Distance (m) from (x, y) to the nearest wall, box face or pillar surface (inf: none).
+
+        People are not included (they move: the simulation adds them, :mod:`drivers.sim.people`).
+        """
         best = math.inf
         if self.n_segments:
             ap = np.array([x, y]) - self.seg_a
             t = np.clip(np.sum(ap * self._seg_e, axis=1) / np.maximum(self.seg_len**2, EPS), 0.0, 1.0)
             closest = self.seg_a + t[:, None] * self._seg_e
             best = float(np.min(np.hypot(closest[:, 0] - x, closest[:, 1] - y)))
+        if self.n_pillars:
+            xy, r = self.circle_xy[: self.n_pillars], self.circle_r[: self.n_pillars]
+            best = min(best, float(np.min(np.hypot(xy[:, 0] - x, xy[:, 1] - y) - r)))
+        return best
+
+    def nearest(self, x: float, y: float) -> tuple[float, float]:
+        """Distance (m) and direction (rad, world) from (x, y) to the nearest point of any surface,
+        people included ((inf, 0) in an empty world): where a robot there would touch first."""
+        best, direction = math.inf, 0.0
+        if self.n_segments:
+            ap = np.array([x, y]) - self.seg_a
+            t = np.clip(np.sum(ap * self._seg_e, axis=1) / np.maximum(self.seg_len**2, EPS), 0.0, 1.0)
+            closest = self.seg_a + t[:, None] * self._seg_e
+            d = np.hypot(closest[:, 0] - x, closest[:, 1] - y)
+            i = int(np.argmin(d))
+            best, direction = float(d[i]), math.atan2(closest[i, 1] - y, closest[i, 0] - x)
         if len(self.circle_r):
             d = np.hypot(self.circle_xy[:, 0] - x, self.circle_xy[:, 1] - y) - self.circle_r
-            best = min(best, float(np.min(d)))
+            i = int(np.argmin(d))
+            if d[i] < best:
+                best, direction = float(d[i]), math.atan2(self.circle_xy[i, 1] - y, self.circle_xy[i, 0] - x)
+        return best, direction
+
+    def move_people(self, xy: np.ndarray) -> None:
+        """Put the people's centres at ``xy`` (one row per person, in the world's order)."""
+        if len(xy) == 0:
+            return
+        rows = slice(self.n_pillars, None)
+        self.circle_xy[rows] = xy
+        if self.atlas is not None:  # the texture anchors of round surfaces are their centres
+            self._u_columns[0][self.n_segments + self.n_pillars :] = xy[:, 0]
+            self._u_columns[1][self.n_segments + self.n_pillars :] = xy[:, 1]
+
+    def cast_rays(self, origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:
+        """Distance (m) along each ray (origins and unit directions, N x 2 each) to the first wall,
+        box face, pillar or person it meets, from either side (inf: none)."""
+        n = len(origins)
+        best = np.full(n, np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if self.n_segments:
+                ex, ey = self._seg_e[:, 0], self._seg_e[:, 1]
+                wx = self.seg_a[:, 0] - origins[:, :1]  # (N, S)
+                wy = self.seg_a[:, 1] - origins[:, 1:]
+                dx, dy = dirs[:, :1], dirs[:, 1:]
+                inv = 1.0 / (dx * ey - dy * ex)
+                t = (wx * ey - wy * ex) * inv
+                s = (wx * dy - wy * dx) * inv
+                hit = np.where((t > EPS) & (np.abs(s - 0.5) <= 0.5 + 1e-9), t, np.inf)
+                best = np.minimum(best, hit.min(axis=1))
+            if len(self.circle_r):
+                cx = self.circle_xy[:, 0] - origins[:, :1]
+                cy = self.circle_xy[:, 1] - origins[:, 1:]
+                b = cx * dirs[:, :1] + cy * dirs[:, 1:]
+                t = b - np.sqrt(b * b - (cx * cx + cy * cy - self.circle_r**2))
+                best = np.minimum(best, np.where(t > EPS, t, np.inf).min(axis=1))
         return best
 
     def collides(self, x: float, y: float, radius: float) -> bool:
@@ -296,17 +361,24 @@ class Scene:
         return self.clearance(x, y) < radius
 
 
-def free_space_problem(world: World, pose: Pose2D) -> str | None:
-    """Why the robot cannot stand at ``pose`` (too close to a wall, box or pillar), or None.
+def free_space_problem(world: World, pose: Pose2D, *, people: bool = True) -> str | None:
+    """Why the robot cannot stand at ``pose`` (too close to a wall, box or pillar, or with
+    ``people`` on a person where they are at time 0), or None.
 
-    The world loader checks the start pose with it, ``bearings run --start`` a pose given on the
-    command line.
+    The world loader checks the start pose with it (people apart: it names the person), ``bearings
+    run --start`` a pose given on the command line.
     """
     clearance = Scene(world).clearance(pose.x, pose.y)
-    if clearance >= world.robot_radius:
-        return None
-    return (f"({pose.x:g}, {pose.y:g}) is not in free space: {max(clearance, 0.0):.2f} m from a wall, box or "
-            f"pillar, less than the robot radius {world.robot_radius:g} m")
+    if clearance < world.robot_radius:
+        return (f"({pose.x:g}, {pose.y:g}) is not in free space: {max(clearance, 0.0):.2f} m from a wall, box or "
+                f"pillar, less than the robot radius {world.robot_radius:g} m")
+    for index, person in enumerate(world.people if people else ()):
+        x, y = position_at(person, 0.0)
+        gap = math.hypot(x - pose.x, y - pose.y) - person.radius
+        if gap < world.robot_radius:
+            return (f"({pose.x:g}, {pose.y:g}) is on person {index} (at ({x:g}, {y:g}) at the start): "
+                    f"{max(gap, 0.0):.2f} m from them, less than the robot radius {world.robot_radius:g} m")
+    return None
 
 
 def _surface_texture(spec: TextureSpec, length: float, height: float) -> np.ndarray:

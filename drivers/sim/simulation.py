@@ -7,10 +7,14 @@ perception benchmarks and ``bearings sim snapshot`` use :meth:`Simulation.snapsh
 Ground truth stays in here; behaviours only see the :class:`~drivers.interfaces.Robot`
 interfaces, exactly as on hardware.
 
+People (:mod:`drivers.sim.people`) walk on the simulated clock and stop for the robot; the robot
+stops at contact with a wall, box, pillar or person. The base has the world's sonar ring and
+bumpers (:mod:`drivers.sim.ranges`) as ``robot.ranges``.
+
 Determinism: every source of randomness is a numpy Generator derived from the seed (wheel slip
-from ``seed`` itself, each camera and the run's lighting from their own spawned streams, so
-adding a camera does not change the robot's motion). Same world and seed: same trajectory,
-bit-identical images and reports.
+from ``seed`` itself, each camera and the run's lighting from their own spawned streams, the sonar
+from a stream of its own, so adding a camera does not change the robot's motion). Same world and
+seed: same trajectory, bit-identical images, ranges and reports.
 """
 
 from __future__ import annotations
@@ -26,13 +30,17 @@ import numpy as np
 from drivers.interfaces import Camera, Robot
 from drivers.sim.cameras import SimCamera, run_lighting
 from drivers.sim.kinematics import DiffDrive, DiffDriveLimits, SlipModel
+from drivers.sim.people import Crowd
 from drivers.sim.ptu import SimPanTilt
+from drivers.sim.ranges import SimRanges
 from drivers.sim.scene import Scene
 from drivers.sim.visualise import RerunLogger
 from drivers.sim.world import load_world
 from drivers.sim.world_values import World, empty_world
 from perception.frame import Frame, LandmarkBearings
-from perception.geometry import Pose2D
+from perception.geometry import Pose2D, wrap_angle
+
+CONTACT_PRECISION_M = 0.0005  # m: a blocked step ends this close to where the robot would touch
 
 
 class SimClock:
@@ -58,6 +66,12 @@ class SimClock:
         self._now = self._ticks * period
 
 
+WATCHDOG_S = 2.0
+"""The simulated base stops when no command arrives for this long, as a Pioneer's firmware does
+(its config packet's Watchdog, 2000 ms; docs/protocols.md): a mission that leaves the base to run
+on without commands stops in the simulator as it would on the robot."""
+
+
 class SimBase:
     """The :class:`~drivers.interfaces.Base` of the simulated robot."""
 
@@ -67,6 +81,7 @@ class SimBase:
 
     def drive(self, v: float, w: float) -> None:
         self.commands.append((self._sim.time, float(v), float(w)))
+        self._sim.last_command = self._sim.time
         self._sim.drive.command(v, w)
 
     def stop(self) -> None:
@@ -114,12 +129,16 @@ class Simulation:
         self.rng = np.random.default_rng(seed)  # wheel slip
         streams = np.random.SeedSequence([seed, 0xBEA], pool_size=4).spawn(1 + len(self.world.cameras))
         self.scene = Scene(self.world)
+        self.crowd = Crowd(self.world.people)
         self.time = 0.0
+        self.last_command = 0.0  # when the base last heard a drive command (the watchdog's clock)
         self.stalled = False
         self.collisions = 0
+        self.collisions_with_people = 0
         self._in_contact = False
         self._stalled_time = 0.0
         self.drive = DiffDrive(start=start or self.world.start, limits=limits, slip=slip, rng=self.rng)
+        self.min_clearance = self._clearance(*self.drive.true_pose[:2]) - self.world.robot_radius
         self.ptu = SimPanTilt(self.world.ptu, clock=lambda: self.time)
         self.lighting = run_lighting(self.world.lighting, np.random.default_rng(streams[0]))
         self.cameras: dict[str, SimCamera] = {}
@@ -131,7 +150,11 @@ class Simulation:
             camera.enabled_noise = noise
             self.cameras[spec.name] = camera
         cameras: dict[str, Camera] = dict(self.cameras)
-        self.robot = Robot(base=SimBase(self), ptu=self.ptu, cameras=cameras, name=f"sim:{self.name}")
+        sonar_rng = np.random.default_rng(np.random.SeedSequence([seed, 0x50AA]))
+        self.ranges = SimRanges.of(self.world.ranges, self.scene, self._ranges_state, radius=self.world.robot_radius,
+                                   rng=sonar_rng)
+        self.robot = Robot(base=SimBase(self), ptu=self.ptu, cameras=cameras, ranges=self.ranges,
+                           name=f"sim:{self.name}")
         self.truth = GroundTruth()
         self.truth.record(0.0, self.drive.true(0.0), self.drive.odometry(0.0))
         self._rerun = RerunLogger()
@@ -153,37 +176,76 @@ class Simulation:
     def step(self, dt: float) -> None:
         """Advance the world by ``dt`` seconds of simulated time.
 
-        A step that would bring the robot's disc into a wall, box or pillar (closer than it was)
-        does not happen: the base stops there, its wheels and odometry included, and
-        :meth:`SimBase.stalled` is True until a command moves it away.
+        A step that would bring the robot's disc into a wall, box, pillar or person (closer than
+        it was) ends where the disc touches (within :data:`CONTACT_PRECISION_M`): the base stops
+        there, its wheels and odometry included, the contact is counted (once per episode), and
+        :meth:`SimBase.stalled` is True until a command moves it away. Then the people walk
+        (:class:`~drivers.sim.people.Crowd`: they wait for the robot rather than walk into it). A base
+        that has heard no command for :data:`WATCHDOG_S` stops, as the robot's firmware stops it.
         """
         drive = self.drive
+        if self.time - self.last_command >= WATCHDOG_S - 1e-9 and drive.target != (0.0, 0.0):
+            drive.command(0.0, 0.0)  # the firmware's watchdog: no command for WATCHDOG_S, the base stops
         before_true, before_odom = drive.true_pose.copy(), drive.odom_pose.copy()
         drive.step(dt, blocked=False)
+        after_true, after_odom = drive.true_pose.copy(), drive.odom_pose.copy()
         radius = self.world.robot_radius
-        clearance, at_end = self._swept_clearance(before_true[:2], drive.true_pose[:2], radius)
+        swept = self._swept_clearance(before_true[:2], after_true[:2], radius)
+        clearance, at_end, by_person, fixed_at_end = swept
         # blocked: touching, and closer than before (a robot in contact may still back away)
-        if clearance < radius and clearance < self.scene.clearance(before_true[0], before_true[1]) - 1e-12:
-            drive.true_pose, drive.odom_pose = before_true, before_odom
+        if clearance < radius and clearance < self._clearance(before_true[0], before_true[1]) - 1e-12:
+            f = self._contact_fraction(before_true[:2], after_true[:2], radius)
+            drive.true_pose = _between(before_true, after_true, f)
+            drive.odom_pose = _between(before_odom, after_odom, f)
+            fixed_at_end = self.scene.clearance(*drive.true_pose[:2])
             drive.velocity = (0.0, 0.0)
             if not self._in_contact:  # a new contact episode (not the same push, step after step)
                 self.collisions += 1
+                self.collisions_with_people += int(by_person)
             self.stalled = self._in_contact = True
         else:
             self.stalled = False
             self._in_contact = self._in_contact and at_end < radius + 0.01
         if self.stalled:
             self._stalled_time += dt
+        self.crowd.step(dt, drive.true_pose[:2], radius)
+        self.scene.move_people(self.crowd.xy)
         self.ptu.step(dt)
         self.time += dt
+        here = min(fixed_at_end, self.crowd.clearance(*drive.true_pose[:2]))  # the people have moved
+        self.min_clearance = min(self.min_clearance, here - radius)
         self.truth.record(self.time, drive.true(self.time), drive.odometry(self.time))
 
-    def _swept_clearance(self, start: np.ndarray, end: np.ndarray, radius: float) -> tuple[float, float]:
+    def _clearance(self, x: float, y: float) -> float:
+        """Distance (m) from (x, y) to the nearest wall, box face, pillar or person."""
+        return min(self.scene.clearance(x, y), self.crowd.clearance(x, y))
+
+    def _swept_clearance(self, start: np.ndarray, end: np.ndarray,
+                         radius: float) -> tuple[float, float, bool, float]:
         """The smallest clearance along a step's straight path, sampled every radius / 2 (so a long
-        step cannot jump over a thin wall), and the clearance at its end."""
+        step cannot jump over a thin wall), the clearance at its end, whether a person is the
+        nearest thing where the clearance is smallest, and the walls', boxes' and pillars' alone at
+        its end."""
         samples = max(1, math.ceil(math.hypot(end[0] - start[0], end[1] - start[1]) / (radius / 2.0)))
-        values = [self.scene.clearance(*(start + (end - start) * (i / samples))) for i in range(1, samples + 1)]
-        return min(values), values[-1]
+        points = [start + (end - start) * (i / samples) for i in range(1, samples + 1)]
+        fixed = [self.scene.clearance(*p) for p in points]
+        people = [self.crowd.clearance(*p) for p in points] if len(self.crowd) else [math.inf] * samples
+        values = [min(a, b) for a, b in zip(fixed, people, strict=True)]
+        nearest = min(range(samples), key=values.__getitem__)
+        return values[nearest], values[-1], people[nearest] < fixed[nearest], fixed[-1]
+
+    def _contact_fraction(self, start: np.ndarray, end: np.ndarray, radius: float) -> float:
+        """The largest fraction of a blocked step (start -> end) the robot can drive before its disc
+        touches (bisection to :data:`CONTACT_PRECISION_M`; 0 when that is less than it: pushing)."""
+        length = math.hypot(end[0] - start[0], end[1] - start[1])
+        lo, hi = 0.0, 1.0
+        while (hi - lo) * length > CONTACT_PRECISION_M:
+            mid = 0.5 * (lo + hi)
+            if self._swept_clearance(start, start + (end - start) * mid, radius)[0] >= radius:
+                lo = mid
+            else:
+                hi = mid
+        return lo if lo * length >= 2 * CONTACT_PRECISION_M else 0.0
 
     def clock(self) -> SimClock:
         """A fresh clock that steps this world once per tick (hand it to the runner)."""
@@ -191,6 +253,9 @@ class Simulation:
 
     # ----------------------------------------------------------------------------------------
     # Ground truth (evaluation only)
+
+    HEADLINE = ("ground_truth.goal_error_m", "ground_truth.path_error_m", "ground_truth.trajectory_length_m")
+    """The ground-truth figures the end-of-run line shows (besides collisions: ``missions/summary.py``)."""
 
     def report_sections(self, evaluation: Mapping[str, Any]) -> dict[str, Any]:
         """What a run report gets from the simulator: ``ground_truth`` against the mission's
@@ -211,6 +276,10 @@ class Simulation:
         """The whole true trajectory as world (x, y) rows."""
         return np.asarray(self.truth.true)[:, 1:3]
 
+    def people_xy(self) -> np.ndarray:
+        """Where every person is now, world (x, y) rows in the world's order (evaluation only)."""
+        return self.crowd.xy.copy()
+
     def odometry_trajectory_in_world(self) -> np.ndarray:
         """The whole odometry trajectory as world (x, y) rows."""
         return start_to_world(_pose_of(self.truth.true[0]), np.asarray(self.truth.odometry)[:, 1:3])
@@ -222,11 +291,15 @@ class Simulation:
         reference_path: Sequence[Sequence[float]] | None = None,
         frame: str = "world",
     ) -> dict:
-        """The ``ground_truth`` section of a run report (DESIGN.md, contracts).
+        """The ``ground_truth`` section of a run report (docs/design.md, contracts).
 
-        Always: ``trajectory_length_m``, ``final_pose``, ``odometry_drift_m``, ``collisions``,
-        ``stalled_time_s``, ``trajectory`` (decimated), ``stops`` (every stretch the robot stood
-        still, exactly: see :func:`_stops`) and the true ``landmarks``; with ``goal``
+        Always: ``trajectory_length_m``, ``final_pose``, ``odometry_drift_m``, ``collisions`` (every
+        contact episode: the robot ran into something), ``collisions_with_people`` (those of them
+        with a person; people stop for the robot, so a contact is always the robot's doing),
+        ``min_clearance_m`` (the smallest distance from the robot's disc to any wall, box, pillar
+        or person over the run; None in a world with nothing in it), ``stalled_time_s``,
+        ``trajectory`` (decimated), ``stops`` (every stretch the robot stood still, exactly: see
+        :func:`_stops`) and the true ``landmarks``; with ``goal``
         (x, y): ``goal_error_m``; with a ``reference_path`` of (x, y) points: ``path_error_m``
         (mean distance of the trajectory to it) and ``path_error_max_m``. ``goal`` and
         ``reference_path`` are world coordinates, or with ``frame="start"`` coordinates relative
@@ -247,10 +320,15 @@ class Simulation:
             "final_pose": {"x": float(true[-1, 1]), "y": float(true[-1, 2]), "theta": float(true[-1, 3])},
             "odometry_drift_m": float(np.linalg.norm(true[-1, 1:3] - self.odometry_in_world())),
             "collisions": int(self.collisions),
+            "collisions_with_people": int(self.collisions_with_people),
+            "min_clearance_m": float(self.min_clearance) if math.isfinite(self.min_clearance) else None,
             "stalled_time_s": float(self._stalled_time),
             "trajectory": _decimate(true, max_points=2000),
             "stops": _stops(true),
             "landmarks": [[int(lm.id), lm.x, lm.y, lm.z] for lm in self.world.landmarks],
+            # where odometry believed the robot was, (t, x, y) in the world (odometry starts at the true start)
+            "odometry_trajectory": _decimate(np.column_stack([np.asarray(self.truth.odometry)[:, 0],
+                                                              self.odometry_trajectory_in_world()]), max_points=2000),
         }
         if goal is not None:
             report["goal_error_m"] = float(math.hypot(xy[-1, 0] - goal[0], xy[-1, 1] - goal[1]))
@@ -290,19 +368,26 @@ class Simulation:
     def _camera_state(self) -> tuple[Pose2D, float, float, float]:
         return self.true_pose(), self.ptu.pan, self.ptu.tilt, self.time
 
+    def _ranges_state(self) -> tuple[Pose2D, float]:
+        return self.true_pose(), self.time
+
     # ----------------------------------------------------------------------------------------
     # Visualisation
 
-    def log_rerun(self, rec: Any, *, image_every: int | None = None) -> None:
+    def log_rerun(self, rec: Any) -> None:
         """Log this tick to rerun (``rec``: the rerun module or a RecordingStream).
 
         Once: the world from above (walls, pillars, landmarks, named poses, static). Every call:
         the true and odometry poses, heading and pan-tilt view direction. Every 20th call: the
-        trajectories. Every ``image_every``-th call (default 10): the latest frame of each camera.
+        trajectories. Camera images are the recorder's (the frames the mission grabbed).
         """
-        if image_every is not None:
-            self._rerun.image_every = max(1, int(image_every))
         self._rerun.log(self, rec)
+
+
+def _between(a: np.ndarray, b: np.ndarray, f: float) -> np.ndarray:
+    """The (x, y, theta) pose a fraction ``f`` of the way from ``a`` to ``b`` (the shorter turn)."""
+    theta = wrap_angle(a[2] + f * wrap_angle(b[2] - a[2]))
+    return np.array([a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), theta])
 
 
 def path_distances(trajectory_xy: np.ndarray, reference_xy: np.ndarray) -> np.ndarray:

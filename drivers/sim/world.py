@@ -29,8 +29,10 @@ from drivers.sim.world_values import (
     Landmark,
     Lighting,
     MountPose,
+    Person,
     Pillar,
     PtuSpec,
+    RangeSpec,
     TextureSpec,
     Wall,
     World,
@@ -44,6 +46,7 @@ from perception.geometry import Pose2D
 FORMAT_VERSION = wf.FORMAT_VERSION
 CAMERA_KINDS = ("bearings", "panorama", "catadioptric", "pinhole", "stereo")
 MOUNTS = ("base", "ptu")
+PERSON_TEXTURE = {"feature_size": 0.1, "brightness": 90.0}  # people's default: darker, finer than walls
 
 
 # --------------------------------------------------------------------------------------------
@@ -103,6 +106,8 @@ def parse_world(data: Any, *, file: str, default_name: str = "world") -> World:
         start=_pose(model.start),
         poses={name: _pose(pose) for name, pose in model.poses.items()},
         robot_radius=model.robot.radius,
+        ranges=RangeSpec(model.robot.sonar, model.robot.sonar_noise_m, model.robot.sonar_miss_probability,
+                         model.robot.sonar_max_range, model.robot.bumpers),
         ptu=_ptu(model.ptu),
         cameras=tuple(_camera(c) for c in model.cameras) if model.cameras is not None else default_cameras(),
         lighting=Lighting(model.lighting.gain, model.lighting.bias, model.lighting.run_variation),
@@ -132,11 +137,11 @@ def _texture(spec: wf.Texture | None, default: TextureSpec) -> TextureSpec:
 
 
 def _surfaces(model: wf.WorldFile) -> dict[str, Any]:
-    """Walls (boxes become one-sided closed walls) and pillars, with textures seeded per surface."""
+    """Walls (boxes become one-sided closed walls), pillars and people, with textures seeded per surface."""
     counter = iter(range(1, 1_000_000))
 
-    def texture(surface: wf.Textured) -> TextureSpec:
-        return _texture(surface.texture, TextureSpec(seed=model.seed * 1000 + next(counter)))
+    def texture(surface: wf.Textured, **default: Any) -> TextureSpec:
+        return _texture(surface.texture, TextureSpec(seed=model.seed * 1000 + next(counter), **default))
 
     walls = []
     for wall in model.walls:
@@ -150,7 +155,9 @@ def _surfaces(model: wf.WorldFile) -> dict[str, Any]:
     pillars = [Pillar(p.center[0], p.center[1], p.radius, p.height, texture(p)) for p in model.pillars]
     landmarks = [Landmark(lm.id if lm.id is not None else i, lm.position[0], lm.position[1], lm.position[2], lm.size)
                  for i, lm in enumerate(model.landmarks)]
-    return {"walls": tuple(walls), "pillars": tuple(pillars), "landmarks": tuple(landmarks)}
+    people = [Person(tuple((q[0], q[1]) for q in p.path), p.radius, p.height, texture(p, **PERSON_TEXTURE), p.speed,
+                     p.wait_s, p.loop) for p in model.people]
+    return {"walls": tuple(walls), "pillars": tuple(pillars), "landmarks": tuple(landmarks), "people": tuple(people)}
 
 
 def _pose(pose: wf.Pose) -> Pose2D:
@@ -210,11 +217,27 @@ def _whole_world_problems(world: World, data: YamlMap, file: str) -> list[Diagno
 
 
 def _start_problems(world: World, data: YamlMap, file: str) -> list[Diagnostic]:
-    problem = free_space_problem(world, world.start)
+    problem = free_space_problem(world, world.start, people=False)
     if problem is None:
-        return []
+        return _people_on_start(world, data, file)
     mark = data.value_mark_of("start") if "start" in data else data.mark
     return [Diagnostic(file, mark.line, mark.col, f"the robot's start {problem}")]
+
+
+def _people_on_start(world: World, data: YamlMap, file: str) -> list[Diagnostic]:
+    """A person who starts (or stands) on the robot's start pose, as a start inside an obstacle is."""
+    problems = []
+    entries = data.get("people")
+    start = world.start
+    for index, person in enumerate(world.people):
+        x, y = person.path[0]
+        gap = math.hypot(x - start.x, y - start.y)
+        if gap < person.radius + world.robot_radius:
+            mark = entries[index].mark if isinstance(entries, YamlList) else data.mark
+            problems.append(Diagnostic(file, mark.line, mark.col, (
+                f"person {index} starts on the robot's start: ({x:g}, {y:g}) is {gap:.2f} m from ({start.x:g}, "
+                f"{start.y:g}), less than its radius plus the robot's ({person.radius + world.robot_radius:g} m)")))
+    return problems
 
 
 def _camera_height(spec: CameraSpec, ptu: PtuSpec) -> float:

@@ -8,8 +8,10 @@ and radians in ``World``.
 
 Every quantity is bounded so that loading and rendering a world takes memory and time in
 proportion to what it declares: coordinates within 10 km (landmarks within 100 km, for
-horizons), heights and radii within 100 m, at most a few thousand surfaces, and a texture
-budget for the whole world (:data:`MAX_TEXTURE_TEXELS`).
+horizons), heights and radii within 100 m, at most a few thousand surfaces, a texture budget for
+the whole world (:data:`MAX_TEXTURE_TEXELS`) and a rendering budget for its cameras
+(:data:`MAX_RENDER_BYTES`: pixels times the renderer's memory per pixel, which ``bearings bench
+sim`` measures), so no camera can take the machine's memory.
 """
 
 from __future__ import annotations
@@ -30,6 +32,13 @@ MAX_SURFACES = 5_000
 MAX_LANDMARKS = 100_000
 MAX_TEXTURE_SIDE = 16_000  # texels: one surface's texture must fit the atlas (cv2.remap limit)
 MAX_TEXTURE_TEXELS = 200_000_000  # all surfaces together: about 200 MB of 8-bit texture
+MAX_PEOPLE = 200
+MAX_PATH_POINTS = 1_000
+RENDER_BYTES_PER_PIXEL = 720  # peak memory per pixel of a camera rendered through lookup tables (pinhole,
+# stereo, catadioptric, a tilted panorama): every pixel's bearing, the remap tables, the source panorama;
+# bearings bench sim measures it (render_bytes_per_pixel: ~690 for a pinhole)
+LEVEL_PANORAMA_BYTES_PER_PIXEL = 32  # a level panorama on the base is ray-cast directly (measured: ~20)
+MAX_RENDER_BYTES = 4_000_000_000  # all of a world's cameras together
 
 
 def _m(description: str, **bounds: Any) -> Any:
@@ -133,6 +142,40 @@ class Pillar(Textured):
         return self
 
 
+class Person(Textured):
+    """A person: a vertical cylinder standing on the floor, still or walking along a path.
+
+    A person walks the path at ``speed`` and waits ``wait_s`` at each end: with ``loop``, round the
+    path and back to its first point (waiting there); without, to its last point and back. A path
+    of one point is a person standing still. People walk through walls (nothing stops them but the
+    robot: they stop while their next step would touch it).
+    """
+
+    path: list[Point] = Field(min_length=1, max_length=MAX_PATH_POINTS,
+                              description="where the person walks, [[x, y], ...] in m (one point: standing)")
+    speed: float = Field(1.0, gt=0.0, le=3.0, description="walking speed", json_schema_extra={"unit": "m/s"})
+    radius: float = _m("of the cylinder", default=0.25, gt=0.0, le=1.0)
+    height: float = _m("of the cylinder", default=1.75, gt=0.0, le=3.0)
+    wait_s: float = Field(0.0, ge=0.0, le=3600.0, description="how long the person waits at each end of the path",
+                          json_schema_extra={"unit": "s"})
+    loop: bool = Field(False, description="walk round the path back to its first point (false: back and forth)")
+
+    @model_validator(mode="after")
+    def _steps(self) -> Person:
+        points = self.points_closed
+        for i in range(1, len(points)):
+            if points[i] == points[i - 1]:
+                back = " (a loop walks back to its first point by itself)" if i == len(self.path) else ""
+                raise ValueError(f"path points {i - 1} and {i % len(self.path)} are equal: a step of no length{back}")
+        self.check_texture(2 * math.pi * self.radius, self.height)
+        return self
+
+    @property
+    def points_closed(self) -> list[list[float]]:
+        """The path, with the way back to its first point when it loops."""
+        return [*self.path, self.path[0]] if self.loop and len(self.path) > 1 else self.path
+
+
 class Landmark(BaseModel):
     """A point landmark (for the bearings sensor; drawn as a small disc in images)."""
 
@@ -167,6 +210,13 @@ class Robot(BaseModel):
     model_config = FILE_MODEL_CONFIG
 
     radius: float = _m("collision disc (Pioneer 3-DX: 0.26)", default=0.26, gt=0.0, le=5.0)
+    sonar: Literal["p3dx", "p3at", "none"] = Field(
+        "p3dx", description="the sonar ring: a Pioneer 3-DX's or 3-AT's 16 transducers (docs/worlds.md), or none")
+    sonar_noise_m: float = _m("sigma of the Gaussian noise on each sonar range", default=0.02, ge=0.0, le=1.0)
+    sonar_miss_probability: float = Field(0.01, ge=0.0, le=1.0,
+                                          description="probability that a transducer hears no echo when it fires")
+    sonar_max_range: float = _m("farther echoes are not reported", default=5.0, gt=0.1, le=20.0)
+    bumpers: bool = Field(True, description="front and rear bumper segments (5 each, as on a Pioneer 3)")
 
 
 Limits = Annotated[list[float], Field(min_length=2, max_length=2, description="[lowest, highest] in degrees")]
@@ -242,6 +292,17 @@ class Camera(BaseModel):
         self.image_model()  # the perception model's own checks, reported with the file's other problems
         return self
 
+    def render_bytes(self) -> int:
+        """The renderer's peak memory for this camera (0 for the bearings sensor): its pixels (both
+        images of a stereo pair) times the measured bytes per pixel of its way of rendering."""
+        model = self.image_model()
+        if model is None:
+            return 0
+        eyes = [model.left, model.right] if isinstance(model, StereoRig) else [model]
+        pixels = sum(eye.width * eye.height for eye in eyes)
+        level = self.kind == "panorama" and self.mount == "base" and (self.pose is None or self.pose.pitch_deg == 0)
+        return pixels * (LEVEL_PANORAMA_BYTES_PER_PIXEL if level else RENDER_BYTES_PER_PIXEL)
+
     def image_model(self) -> Any:
         """The perception camera model of an image camera (None for the bearings sensor)."""
         if self.kind == "bearings":
@@ -313,6 +374,8 @@ class WorldFile(BaseModel):
     boxes: list[Box] = Field(default_factory=list, max_length=MAX_SURFACES)
     pillars: list[Pillar] = Field(default_factory=list, max_length=MAX_SURFACES)
     landmarks: list[Landmark] = Field(default_factory=list, max_length=MAX_LANDMARKS)
+    people: list[Person] = Field(default_factory=list, max_length=MAX_PEOPLE,
+                                 description="people standing or walking (drawn in every camera, they block the robot)")
     start: Pose = Field(default_factory=lambda: Pose(x=0.0, y=0.0), description="the robot's true start pose")
     poses: dict[str, Pose] = Field(default_factory=dict, max_length=10_000, description="named poses")
     robot: Robot = Field(default_factory=Robot)
@@ -320,11 +383,23 @@ class WorldFile(BaseModel):
     cameras: list[Camera] | None = Field(None, min_length=1, max_length=32, description="default: one of each kind")
     lighting: Lighting = Field(default_factory=Lighting)
 
+    @field_validator("cameras")
+    @classmethod
+    def _render_budget(cls, cameras: list[Camera] | None) -> list[Camera] | None:
+        total = sum(camera.render_bytes() for camera in cameras or ())
+        if total > MAX_RENDER_BYTES:
+            raise ValueError(f"rendering them would take about {total / 1e9:.1f} GB (at most "
+                             f"{MAX_RENDER_BYTES / 1e9:.0f} GB: {RENDER_BYTES_PER_PIXEL} bytes per pixel, "
+                             f"{LEVEL_PANORAMA_BYTES_PER_PIXEL} for a level panorama, as bearings bench sim "
+                             "measures): fewer or smaller cameras")
+        return cameras
+
     @model_validator(mode="after")
     def _texture_budget(self) -> WorldFile:
         texels = sum(w.texels(w.length, w.height) for w in self.walls)
         texels += sum(b.texels(2 * sum(b.size), b.height) for b in self.boxes)
         texels += sum(p.texels(2 * math.pi * p.radius, p.height) for p in self.pillars)
+        texels += sum(p.texels(2 * math.pi * p.radius, p.height) for p in self.people)
         if texels > MAX_TEXTURE_TEXELS:
             raise ValueError(f"the world's textures would take {texels / 1e6:.0f} MB (at most "
                              f"{MAX_TEXTURE_TEXELS / 1e6:.0f} MB): lower pixels_per_m or the surfaces' size")

@@ -1,11 +1,11 @@
 """What a simulated world is: the values a world file describes, in SI units and radians.
 
 A world is a flat floor with vertical surfaces on it (wall polylines, boxes, round pillars), point
-landmarks anywhere in 3D, a ceiling or an open sky, the robot's start and named poses, its pan-tilt
-unit and cameras, and the lighting. These values are what the simulator's geometry
-(:mod:`drivers.sim.scene`), textures and cameras are built from; reading and checking a world
-file into them is :mod:`drivers.sim.world`'s job. They import nothing of the simulator, so every
-module of it can use them.
+landmarks anywhere in 3D, people standing or walking, a ceiling or an open sky, the robot's start
+and named poses, its range sensors, pan-tilt unit and cameras, and the lighting. These values are
+what the simulator's geometry (:mod:`drivers.sim.scene`), textures and cameras are built from;
+reading and checking a world file into them is :mod:`drivers.sim.world`'s job. They import nothing
+of the simulator, so every module of it can use them.
 """
 
 from __future__ import annotations
@@ -52,6 +52,36 @@ class Pillar:
     radius: float
     height: float
     texture: TextureSpec
+
+
+@dataclass(frozen=True, slots=True)
+class Person:
+    """A person: a vertical cylinder that stands still or walks along ``path``.
+
+    With ``loop`` the person walks round the path back to its first point and waits ``wait``
+    there; without, to the last point, waits, walks back and waits at the first. Where a person
+    is at any moment is :func:`drivers.sim.people.position_at`.
+    """
+
+    path: tuple[tuple[float, float], ...]
+    radius: float
+    height: float
+    texture: TextureSpec
+    speed: float = 1.0  # m/s
+    wait: float = 0.0  # s at each end
+    loop: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class RangeSpec:
+    """The robot's range sensors: which sonar ring (``p3dx``, ``p3at``, ``none``), its noise and
+    missed echoes, its reach, and whether it has bumpers (:mod:`drivers.sim.ranges`)."""
+
+    sonar: str = "p3dx"
+    noise: float = 0.02  # m, sigma of each range
+    miss_probability: float = 0.01  # a firing hears no echo
+    max_range: float = 5.0  # m
+    bumpers: bool = True
 
 
 @dataclass(frozen=True, slots=True)
@@ -132,12 +162,14 @@ class World:
     walls: tuple[Wall, ...] = ()
     pillars: tuple[Pillar, ...] = ()
     landmarks: tuple[Landmark, ...] = ()
+    people: tuple[Person, ...] = ()
     ceiling: float | None = None  # m; None: open sky
     floor: TextureSpec = TextureSpec(seed=0, pixels_per_m=25.0, feature_size=0.25, contrast=0.6)
     ground_margin: float = 10.0
     start: Pose2D = Pose2D()
     poses: dict[str, Pose2D] = field(default_factory=dict)
     robot_radius: float = 0.26
+    ranges: RangeSpec = RangeSpec()
     ptu: PtuSpec = PtuSpec()
     cameras: tuple[CameraSpec, ...] = ()
     lighting: Lighting = Lighting()
@@ -154,7 +186,7 @@ class World:
         return tuple(spec.name for spec in self.cameras)
 
     def bounds(self) -> tuple[float, float, float, float]:
-        """(xmin, ymin, xmax, ymax) of walls, pillars, start and poses (landmarks excluded)."""
+        """(xmin, ymin, xmax, ymax) of walls, pillars, people's paths, start and poses (landmarks excluded)."""
         xs = [self.start.x, *(p.x for p in self.poses.values())]
         ys = [self.start.y, *(p.y for p in self.poses.values())]
         for wall in self.walls:
@@ -163,6 +195,9 @@ class World:
         for p in self.pillars:
             xs += [p.x - p.radius, p.x + p.radius]
             ys += [p.y - p.radius, p.y + p.radius]
+        for person in self.people:
+            xs += [q[0] + s * person.radius for q in person.path for s in (-1, 1)]
+            ys += [q[1] + s * person.radius for q in person.path for s in (-1, 1)]
         return min(xs), min(ys), max(xs), max(ys)
 
 

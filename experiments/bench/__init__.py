@@ -11,4 +11,5 @@ AREAS = {
     "ltmap": "experiments.bench.ltmap",
     "localisation": "experiments.bench.localisation",
     "sweep": "experiments.bench.sweep",
+    "run": "experiments.bench.run",
 }

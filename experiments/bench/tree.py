@@ -3,6 +3,9 @@
 Figures: microseconds per tick for (a) py_trees ``tick_once`` of the task tree alone, (b) the
 runner's whole tick (sense branch, task tree, command clearing and dispatch) without the
 simulator, and (c) the same with the empty-world simulator stepped each tick; ratios b/a and c/a.
+And (d) one check of the collision monitor, which the runner makes every tick on a robot with
+range sensors: a Pioneer 3-DX's 16 sonar readings against its box footprint and default zones,
+an arc command; ratio d/a.
 """
 
 from __future__ import annotations
@@ -11,14 +14,19 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
 import py_trees
 
 from behaviours.clock import ManualClock
 from drivers.fake import fake_robot
+from drivers.pioneer_body import BODIES
+from drivers.safety.settings import monitor_config
 from drivers.sim.simulation import Simulation
 from missions.builder import build_node
 from missions.loader import load_mission
 from missions.runner import Runner, RunOptions
+from perception.collision_monitor import CollisionMonitor
+from perception.ranges import RangeScan
 
 BRANCH = """
       - Sequence:
@@ -75,15 +83,26 @@ def _time_bare(mission, ticks: int) -> float:
     return (time.perf_counter() - start) / ticks * 1e6
 
 
+def _time_monitor(checks: int) -> float:
+    body = BODIES["p3dx"]
+    monitor = CollisionMonitor(monitor_config(None, body.footprint))
+    scan = RangeScan(body.sensors(), np.random.default_rng(0).uniform(0.2, 3.0, len(body.sonar)), 0.0)
+    start = time.perf_counter()
+    for _ in range(checks):
+        monitor.check(0.3, 0.4, scan, 0.0)
+    return (time.perf_counter() - start) / checks * 1e6
+
+
 def run(quick: bool = False) -> dict:
     mission = _mission()
     nodes = sum(1 for _ in mission.tree.walk())
     ticks = 300 if quick else 3000
-    best = {"bare": float("inf"), "runner": float("inf"), "runner_sim": float("inf")}
+    best = {"bare": float("inf"), "runner": float("inf"), "runner_sim": float("inf"), "monitor": float("inf")}
     for _ in range(1 if quick else 3):
         best["bare"] = min(best["bare"], _time_bare(mission, ticks))
         best["runner"] = min(best["runner"], _time_runner(mission, ticks, simulate=False))
         best["runner_sim"] = min(best["runner_sim"], _time_runner(mission, ticks, simulate=True))
+        best["monitor"] = min(best["monitor"], _time_monitor(ticks))
     return {
         "task_tree_nodes": nodes,
         "ticks": ticks,
@@ -92,5 +111,7 @@ def run(quick: bool = False) -> dict:
         "runner_tick_with_sim_us": round(best["runner_sim"], 2),
         "runner_overhead_ratio": round(best["runner"] / best["bare"], 3),
         "runner_with_sim_ratio": round(best["runner_sim"] / best["bare"], 3),
+        "monitor_check_us": round(best["monitor"], 2),
+        "monitor_check_ratio": round(best["monitor"] / best["bare"], 3),
         "max_tick_rate_hz": round(1e6 / best["runner_sim"]),
     }

@@ -23,7 +23,8 @@ and ``map_on_obstacles_m2`` is how much of that map's explored floor lies on wal
 
 Figures per variant (means over seeds unless named otherwise): final ``coverage``, its minimum,
 ``ok`` (episodes that ended by themselves with coverage >= 0.95 and no collision), ``done``,
-``collisions``, ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
+``collisions`` and ``safety_stops`` (summed over the runs), ``min_clearance_m`` (the smallest, when
+the simulator reports it), ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
 and after 60, 120 and 240 s, and the path length and time to reach 50, 80, 90 and 95 % (None when
 not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m to
 the two others'.
@@ -38,12 +39,21 @@ the same time, the odometry frame placed at the true start: ``pose_error_m`` and
 ``heading_error_deg`` at the end, their maxima over the run, the position error after 60, 120 and
 240 s, the final ``pose_sigma_m`` the localisation gave itself, and ``pose_ok`` (episodes that end
 within 0.10 m and 2 degrees).
+
+People (``--option people=N``, :mod:`experiments.eval.people`): N people drawn from the seed,
+standing in the rooms or walking back and forth between two points of the floor the robot
+reaches, none within 1 m of the start, are added to a copy of the world file
+(``people/s<seed>/<world>.yaml`` in the results folder) that every variant of that seed runs in.
+The reference floor stays the world's (people move: they hide no floor for good). The figures
+record the people placed (``people.placed``, ``people.paths``).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import cv2
@@ -53,6 +63,8 @@ from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.simulation import start_to_world
 from drivers.sim.world import load_world
 from experiments.eval import EvalOptions
+from experiments.eval import people as crowd
+from experiments.eval.figures import safety_figures, safety_totals
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.table import read_report
@@ -77,9 +89,18 @@ GOAL = 0.95  # the issue's criterion
 OPTIONS = {
     "localisation": "how the robot localises: visual (the stereo pair's own features; default), ideal (the "
                     "simulator's identified landmarks, an oracle), or visual,ideal (both, side by side)",
+    crowd.OPTION: crowd.HELP + " (in the rooms)",
 }
 LOCALISATIONS = {"visual": "stereo", "ideal": "landmarks"}  # -> the mission's localisation input (a camera)
 POSE_GOAL = (0.10, 2.0)  # m, deg: the localisation's error at the end of a run
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The area's options, checked."""
+
+    localisations: tuple[str, ...] = ("visual",)  # LOCALISATIONS' names, each a set of columns
+    people: int = 0  # people in the rooms
 
 
 def check_world(world: str) -> FloorGrid:
@@ -91,8 +112,9 @@ def check_world(world: str) -> FloorGrid:
     return floor
 
 
-def check_options(world: str, extra: Mapping[str, str]) -> tuple[str, ...]:
-    """The localisations the ``localisation`` option names, checked against the world's cameras."""
+def check_options(world: str, extra: Mapping[str, str]) -> Settings:
+    """The options (``OPTIONS``) checked: the localisations (against the world's cameras) and the number
+    of people; ``ValueError`` with the problem."""
     names = tuple(dict.fromkeys(n.strip() for n in extra.get("localisation", "visual").split(",")))
     unknown = [n for n in names if n not in LOCALISATIONS]
     if unknown or not names:
@@ -102,7 +124,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> tuple[str, ...]:
         if LOCALISATIONS[name] not in cameras:
             raise ValueError(f"localisation {name} needs the camera {LOCALISATIONS[name]!r}, which world {world!r} "
                              f"does not have (cameras: {', '.join(sorted(cameras))})")
-    return names
+    return Settings(names, crowd.parse_people(extra.get(crowd.OPTION)))
 
 
 def column(variant: str, localisation: str) -> str:
@@ -110,11 +132,27 @@ def column(variant: str, localisation: str) -> str:
     return variant if localisation == "visual" else f"{variant}/{localisation}"
 
 
-def episodes(world: str, seeds: Sequence[int], max_time_s: float | None = None,
+def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: float | None = None,
              localisations: Sequence[str] = ("visual",)) -> list[Episode]:
-    """The evaluation's runs: every variant on every seed, with every localisation."""
-    return [Episode(MISSION, world, seed, {**inputs, "localisation": LOCALISATIONS[loc]}, max_time_s)
+    """The evaluation's runs: every variant on every seed (in ``world``, or per seed ``world[seed]``),
+    with every localisation."""
+    where = world if isinstance(world, Mapping) else dict.fromkeys(seeds, world)
+    return [Episode(MISSION, where[seed], seed, {**inputs, "localisation": LOCALISATIONS[loc]}, max_time_s)
             for loc in localisations for inputs in VARIANTS.values() for seed in seeds]
+
+
+def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
+                folder: Path) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
+    """Per seed, the world its runs go in (with ``count`` people in the rooms: module docstring) and
+    those people; the world itself when there are none."""
+    if not count:
+        return dict.fromkeys(seeds, world), {}
+    loaded = load_world(world)
+    start = [(loaded.start.x, loaded.start.y)]
+    people = {seed: crowd.in_rooms(loaded, floor, count, seed, keep_clear=start) for seed in seeds}
+    worlds = {seed: str(crowd.world_with_people(world, folder / "people" / f"s{seed:04d}" / f"{Path(world).stem}.yaml",
+                                                people[seed])) for seed in seeds}
+    return worlds, people
 
 
 def variant_of(inputs: dict[str, Any]) -> str:
@@ -233,7 +271,7 @@ def episode_figures(report: dict[str, Any] | None, floor: FloorGrid, robot_radiu
         "coverage": coverage,
         "coverage_map": floor.coverage(placed) if len(placed) else 0.0,
         "map_on_obstacles_m2": on_obstacles * floor.resolution**2,
-        "collisions": int(truth.get("collisions", 0)),
+        **safety_figures(report),
         "path_length_m": float(truth["trajectory_length_m"]),
         "sim_time_s": float(report.get("sim_time_s", truth.get("sim_time_s", 0.0))),
         "odometry_drift_m": float(truth.get("odometry_drift_m", math.nan)),
@@ -301,7 +339,7 @@ def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
         values = [r.get(key) for r in good]
         if good and any(key in r for r in good):
             out[key] = _mean(values)
-    out["collisions"] = sum(int(r.get("collisions", 0)) for r in good)  # a count over the runs, not a mean
+    out.update(safety_totals(good))  # counts over the runs, not means; the smallest clearance
     if any("pose_ok" in r for r in good):
         out["pose_ok"] = sum(bool(r.get("pose_ok")) for r in good)
     return out
@@ -313,10 +351,13 @@ def _ratio(a: float | None, b: float | None) -> float | None:
 
 def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Run the episodes through the sweep runner and compute the figures."""
-    floor, localisations = options.checked or (check_world(options.world),
-                                               check_options(options.world, options.extra))
+    floor = options.checked[0] if options.checked else check_world(options.world)
+    settings = options.checked[1] if options.checked and options.checked[1] is not None else check_options(
+        options.world, options.extra)
+    localisations, count = settings.localisations, settings.people
     world = load_world(options.world)
-    todo = episodes(options.world, options.seeds, options.max_time_s, localisations)
+    where, people = seed_worlds(options.world, count, options.seeds, floor, Path(options.results_dir).resolve())
+    todo = episodes(where, options.seeds, options.max_time_s, localisations)
     rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,
                      progress=options.progress, resume=resume)
     by_variant: dict[str, list[dict[str, Any]]] = {column(name, loc): [] for loc in localisations
@@ -351,13 +392,13 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
             for key in ("map_on_obstacles_m2", "path_length_m"):
                 out[f"{name}_visual_vs_ideal.{key.rsplit('_', 1)[0]}_ratio"] = _ratio(visual.get(key), ideal.get(key))
     out["runs"] = sorted(runs, key=lambda r: (r["variant"], r["seed"]))
-    return out
+    return {**out, **crowd.figures(people, count)} if count else out
 
 
 def format_table(figures: dict[str, Any]) -> str:
     """The comparison as a readable table (one column per variant)."""
     keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "map_on_obstacles_m2", "collisions",
-            "path_length_m", "sim_time_s", *CURVE_FIGURES, "pose_ok", *POSE_FIGURES]
+            "safety_stops", "min_clearance_m", "path_length_m", "sim_time_s", *CURVE_FIGURES, "pose_ok", *POSE_FIGURES]
     names = [column(n, loc) for loc in LOCALISATIONS for n in VARIANTS if f"{column(n, loc)}.coverage" in figures]
     width = max(12, *(len(n) + 2 for n in names))
     lines = [f"exploration in {figures['world']}: {figures['seeds']} seed(s), reachable floor "
@@ -370,4 +411,4 @@ def format_table(figures: dict[str, Any]) -> str:
             text = "-" if value is None else f"{value:.3g}" if isinstance(value, float) else str(value)
             cells.append(text.rjust(width))
         lines.append(key.ljust(24) + "".join(cells))
-    return "\n".join(lines)
+    return "\n".join(lines + crowd.table_line(figures))

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -21,3 +21,29 @@ def cell(value: Any, digits: int = 3) -> str:
     if isinstance(value, float):
         return f"{value:.{digits}f}"
     return str(value)
+
+
+def safety_figures(report: Mapping[str, Any] | None) -> dict[str, Any]:
+    """What one run says about obstacles: ``collisions`` (the simulator's ground truth: contact
+    episodes), ``safety_stops`` (the collision monitor's stop episodes) and ``min_clearance_m``
+    (the true smallest distance from the robot to anything, when the simulator reports it; else
+    None). Every evaluation's criterion requires ``collisions == 0``."""
+    report = report or {}
+    truth, safety = report.get("ground_truth", {}), report.get("safety", {})
+    clearance = truth.get("min_clearance_m")
+    return {"collisions": int(truth.get("collisions", 0)), "safety_stops": int(safety.get("safety_stops", 0)),
+            "min_clearance_m": None if clearance is None else float(clearance)}
+
+
+def safety_totals(runs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """Over runs: collisions and safety stops summed (counts, not means), the smallest clearance."""
+    clearances = [float(r["min_clearance_m"]) for r in runs if r.get("min_clearance_m") is not None]
+    return {"collisions": sum(int(r.get("collisions", 0)) for r in runs),
+            "safety_stops": sum(int(r.get("safety_stops", 0)) for r in runs),
+            "min_clearance_m": min(clearances) if clearances else None}
+
+
+def safety_cells(figures: Mapping[str, Any]) -> str:
+    """``collisions / safety stops / min clearance`` for a table line."""
+    return (f"{figures.get('collisions', 0)} coll, {figures.get('safety_stops', 0)} stops, clear "
+            f"{cell(figures.get('min_clearance_m'), 2)}")

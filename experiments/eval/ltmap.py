@@ -27,8 +27,11 @@ Figures (simulator ground truth, evaluation only), per repeat:
 - ``path_error_m``: mean distance of the repeat's true trajectory (decimated as in the report) to
   the teach's true trajectory (a polyline); searches for a lost trail count too.
 - ``goal_error_m``: distance from where the repeat ended to the route's start (where the teach began).
-- ``reached`` (the goal): the mission ended in SUCCESS (its last viewframe switched) *and*
-  ``goal_error_m`` <= the goal tolerance: the robot's diameter or the mean spacing of the taught
+- ``collisions``, ``safety_stops``, ``min_clearance_m``: the run's contacts (ground truth), the
+  collision monitor's stops, the true smallest clearance when the simulator reports it
+  (:func:`~experiments.eval.figures.safety_figures`).
+- ``reached`` (the goal): the mission ended in SUCCESS (its last viewframe switched), without a
+  collision, *and* ``goal_error_m`` <= the goal tolerance: the robot's diameter or the mean spacing of the taught
   viewframes (true places, consecutive), whichever is larger, per seed; the map tells places
   apart no finer than its spacing (indoors a few decimetres, outdoors metres, where far landmarks
   change slowly). ``--option goal_tolerance=M`` fixes it instead.
@@ -38,9 +41,16 @@ Maps are written by the teach episodes into the results folder and read by the r
 this module: on a Dask cluster (``--cluster``) that folder (``-o DIR``) must be one the workers and
 this machine share.
 
+People (``--option people=N``, :mod:`experiments.eval.people`): N people drawn from the seed,
+standing on the taught route or walking across it, none within 1 m of its start or end, are added
+to a copy of the world file (``people/s<seed>/<world>.yaml`` in the results folder) that the
+seed's repeats run in; the teach runs in the world as it is (the route is taught, then repeated
+home with people in it). The figures record the people placed (``people.placed``, ``people.paths``).
+
 A row (per number of levels cut, 0 = the full tree; its ``height`` is the same for every seed
-unless seeds taught trees of different heights, then the range) holds the means over its seeds and
-``goal_reached`` of ``seeds``. A seed whose teach failed has no repeats (``teach_failed``).
+unless seeds taught trees of different heights, then the range) holds the means over its seeds,
+``goal_reached`` of ``seeds``, and over its repeats the collisions and safety stops summed and the
+smallest clearance. A seed whose teach failed has no repeats (``teach_failed``).
 """
 
 from __future__ import annotations
@@ -56,7 +66,8 @@ import numpy as np
 from drivers.sim.simulation import path_distances
 from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
-from experiments.eval.figures import cell, mean_present
+from experiments.eval import people as crowd
+from experiments.eval.figures import cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.ltmap_route import Route, default_route, given_route, parse_route
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
@@ -77,6 +88,7 @@ OPTIONS = {
                       "(default: the robot's diameter or the taught viewframes' spacing, whichever is larger)",
     "rotation": "how the repeat estimates its rotation: zinf (Z-infinity, the paper; default) or compass (the "
                 "median bearing change of every landmark: the comparison for worlds with near landmarks)",
+    crowd.OPTION: crowd.HELP + " (the repeats': on the taught route or across it)",
 }
 ROTATIONS = ("zinf", "compass")
 TEACH, FOLLOW = "teach_route", "follow_route"
@@ -95,6 +107,7 @@ class Settings:
     min_landmarks: int | None  # None: from the map (module docstring)
     goal_tolerance: float | None  # m; None: per seed from the robot and the map (module docstring)
     rotation: str = "zinf"  # FollowRoute's rotation estimate (ROTATIONS)
+    people: int = 0  # people in the repeats' world
 
 
 def check_world(world: str) -> World:
@@ -128,7 +141,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     rotation = extra.get("rotation", "zinf")
     if rotation not in ROTATIONS:
         raise ValueError(f"rotation must be one of {', '.join(ROTATIONS)}, got {rotation!r}")
-    return Settings(camera, route, min_landmarks, tolerance, rotation)
+    return Settings(camera, route, min_landmarks, tolerance, rotation, crowd.parse_people(extra.get(crowd.OPTION)))
 
 
 def _number(text: str, name: str, kind: type[int] | type[float]) -> Any:
@@ -189,8 +202,9 @@ def teach_episode(world: str, seed: int, settings: Settings, folder: Path, max_t
 
 
 def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_landmarks: int,
-                   max_time_s: float | None, rotation: str = "zinf") -> Episode:
-    """The repeat of ``teach``'s map cut by ``level.cut`` levels, from the teach's true end pose."""
+                   max_time_s: float | None, rotation: str = "zinf", world: str | None = None) -> Episode:
+    """The repeat of ``teach``'s map cut by ``level.cut`` levels, from the teach's true end pose, in
+    ``world`` (default: the teach's)."""
     end = report["ground_truth"]["final_pose"]
     start = f"{end['x']:.4f},{end['y']:.4f},{math.degrees(end['theta']):.3f}deg"
     inputs: dict[str, Any] = {"map": teach.inputs["map"], "camera": teach.inputs["camera"], "direction": "reverse",
@@ -202,7 +216,7 @@ def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_
     if max_time_s is None:
         a, b = REPEAT_TIME
         max_time_s = float(math.ceil((a + b * float(report.get("sim_time_s", 0.0))) / 10.0) * 10.0)
-    return Episode(FOLLOW, teach.world, teach.seed, inputs, max_time_s, start)
+    return Episode(FOLLOW, world or teach.world, teach.seed, inputs, max_time_s, start)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -258,13 +272,15 @@ def repeat_figures(teach: Run, repeat: Mapping[str, Any] | None, level: Level,
     then, now = teach.truth.xy, run.truth.xy
     goal_error = float(np.hypot(*(now[-1] - then[0])))
     reached = {int(e["viewframe"]) for e in section.get("reached", [])}
+    safety = safety_figures(repeat)
     out.update({
         "status": repeat["status"],
         "reason": repeat.get("reason", ""),
         "viewframe_error_m": float(np.mean(errors)) if errors else None,
         "path_error_m": float(path_distances(now, then).mean()) if len(then) > 1 else None,
         "goal_error_m": goal_error,
-        "reached": bool(repeat["status"] == "SUCCESS" and goal_error <= tolerance),
+        **safety,
+        "reached": bool(repeat["status"] == "SUCCESS" and safety["collisions"] == 0 and goal_error <= tolerance),
         "viewframes_reached": len(reached) / max(level.viewframes, 1),
         "recoveries": int(section.get("recoveries", 0)),
         "sim_time_s": float(repeat.get("sim_time_s", 0.0)),
@@ -295,6 +311,7 @@ def row_figures(runs: list[dict[str, Any]]) -> dict[str, Any]:
         "viewframes_reached_pct": 100.0 * (mean_present([r.get("viewframes_reached") for r in good]) or 0.0),
         "recoveries": mean_present([r.get("recoveries") for r in good]),
         "sim_time_s": mean_present([r.get("sim_time_s") for r in good]),
+        **safety_totals(good),
     }
     if len(good) < len(runs):
         row["errors"] = len(runs) - len(good)
@@ -315,6 +332,20 @@ def _teach_phase(options: EvalOptions, settings: Settings, folder: Path,
     return {seed: (episode, read_report(folder, episode.id)) for seed, episode in episodes.items()}
 
 
+def repeat_worlds(world: str, loaded: World, settings: Settings, seeds: list[int],
+                  folder: Path) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
+    """Per seed, the world its repeats run in (with ``settings.people`` people on or across the
+    route: module docstring) and those people; the world itself when there are none."""
+    if not settings.people:
+        return {seed: world for seed in seeds}, {}
+    route = settings.route.world_xy
+    people = {seed: crowd.on_ways(loaded, [route], settings.people, seed, keep_clear=[route[0], route[-1]])
+              for seed in seeds}
+    worlds = {seed: str(crowd.world_with_people(world, folder / "people" / f"s{seed:04d}" / f"{Path(world).stem}.yaml",
+                                          people[seed])) for seed in seeds}
+    return worlds, people
+
+
 def _taught(teach: Episode, report: dict[str, Any] | None) -> LandmarkTree | str:
     """The saved map of a teach that succeeded, else why there is none."""
     path = Path(teach.inputs["map"])
@@ -331,6 +362,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Teach on every seed, repeat from every tree height, compute the Table-I figures."""
     world, settings = options.checked or (check_world(options.world), check_options(options.world, options.extra))
     folder = Path(options.results_dir).resolve()
+    repeat_world, people = repeat_worlds(options.world, world, settings, options.seeds, folder)
     teaches = _teach_phase(options, settings, folder, resume)
     plan: list[tuple[Episode, Run, Level]] = []
     failed, teach_rows = [], []
@@ -347,9 +379,9 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
                            "height": tree.height, "bytes": tree.memory_bytes(), "min_landmarks": minimum,
                            "goal_tolerance_m": tolerance[seed],
                            "path_length_m": report["ground_truth"]["trajectory_length_m"],
-                           "sim_time_s": report.get("sim_time_s")})
-        plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation), taught, level)
-                 for level in levels(tree, minimum)]
+                           "sim_time_s": report.get("sim_time_s"), **safety_figures(report)})
+        plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation,
+                                 repeat_world[seed]), taught, level) for level in levels(tree, minimum)]
     if plan:  # every repeat at once: the pool runs them in parallel
         run_sweep([episode for episode, _, _ in plan], executor=options.executor, results_dir=folder,
                   timeout_s=options.timeout_s, progress=options.progress, resume=True)
@@ -357,7 +389,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     for episode, taught, level in plan:
         figures = repeat_figures(taught, read_report(folder, episode.id), level, tolerance[episode.seed])
         runs.append({"seed": episode.seed, **figures})
-    return summarise(world, settings, len(options.seeds), teach_rows, failed, runs)
+    out = summarise(world, settings, len(options.seeds), teach_rows, failed, runs)
+    return {**out, **crowd.figures(people, settings.people)} if settings.people else out
 
 
 def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dict[str, Any]],
@@ -378,23 +411,27 @@ def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dic
         "route": [round(v, 3) for v in settings.route.odometry],
         "route_world": np.round(settings.route.world_xy, 3).tolist(),
         "goal_tolerance_m": mean_present([t["goal_tolerance_m"] for t in teach_rows]),
-        "criterion": (f"SUCCESS within {settings.goal_tolerance:g} m of the route's start"
+        "criterion": (f"SUCCESS without a collision within {settings.goal_tolerance:g} m of the route's start"
                       if settings.goal_tolerance is not None else
-                      "SUCCESS within the robot's diameter or the viewframe spacing (the larger; mean "
-                      f"{cell(mean_present([t['goal_tolerance_m'] for t in teach_rows]), 2)} m) of the route's start"),
+                      "SUCCESS without a collision within the robot's diameter or the viewframe spacing (the larger; "
+                      f"mean {cell(mean_present([t['goal_tolerance_m'] for t in teach_rows]), 2)} m) of the route's "
+                      "start"),
         "taught": len(teach_rows),
         "teach_failed": failed,
         "teach.viewframes": mean_present([t["viewframes"] for t in teach_rows]),
         "teach.height": mean_present([t["height"] for t in teach_rows]),
         "teach.bytes": mean_present([t["bytes"] for t in teach_rows]),
         "teach.path_length_m": mean_present([t["path_length_m"] for t in teach_rows]),
+        **{f"teach.{k}": v for k, v in safety_totals(teach_rows).items()},
         "min_landmarks": sorted({t["min_landmarks"] for t in teach_rows}),
         "repeats": len(runs),
     }
     if rows:
         full = rows[0]
         out.update({f"full.{k}": full[k] for k in ("viewframes", "landmarks", "viewframe_error_m", "path_error_m",
-                                                   "path_error_reached_m", "goal_error_m", "goal_reached")})
+                                                   "path_error_reached_m", "goal_error_m", "goal_reached",
+                                                   "collisions", "safety_stops", "min_clearance_m")})
+        out.update({f"repeats.{k}": v for k, v in safety_totals(runs).items()})
         out.update(memory_limits(rows))
     out["rows"] = rows
     out["teaches"] = teach_rows
@@ -427,7 +464,7 @@ def format_table(figures: Mapping[str, Any]) -> str:
         f"goal reached: {figures['criterion']}; min_landmarks {figures['min_landmarks']}; path error of the repeats "
         "that reached the goal (of all repeats)",
         f"{'height':>6} {'cut':>3} {'viewframes':>10} {'landmarks':>9} {'memory %':>8} {'vf err m':>8} "
-        f"{'path err m':>16} {'goal err m':>10} {'vf reached %':>12} {'goal reached':>12}",
+        f"{'path err m':>16} {'goal err m':>10} {'vf reached %':>12} {'goal reached':>12}  obstacles",
     ]
     for row in figures["rows"]:
         low, high = row["height_range"]
@@ -437,11 +474,13 @@ def format_table(figures: Mapping[str, Any]) -> str:
                      f"{cell(row['landmarks'], 0):>9} {cell(row['memory_pct'], 1):>8} "
                      f"{cell(row['viewframe_error_m']):>8} {path:>16} {cell(row['goal_error_m']):>10} "
                      f"{cell(row['viewframes_reached_pct'], 0):>12} {row['goal_reached']:>7} of {row['seeds']}"
-                     + (f"  ({row['errors']} errors)" if row.get("errors") else ""))
+                     f"  {safety_cells(row)}" + (f"  ({row['errors']} errors)" if row.get("errors") else ""))
     still, lost = figures.get("goal_reached_down_to_memory_pct"), figures.get("goal_first_missed_memory_pct")
     if figures["rows"]:
         lines.append(f"goal reached by every seed down to {cell(still, 1)} % memory; first missed at "
                      f"{cell(lost, 1)} %")
+    lines.append(f"teaching: {safety_cells({k[6:]: v for k, v in figures.items() if k.startswith('teach.')})}")
+    lines += crowd.table_line(figures)
     for fail in figures["teach_failed"]:
         lines.append(f"seed {fail['seed']}: no map to repeat ({fail['problem']})")
     if figures.get("warning"):

@@ -1,5 +1,5 @@
 """``bearings eval roadmap``: learn a roadmap from a few target images, then navigate to its targets
-from unknown start poses (DESIGN.md's algorithm 2, ``docs/roadmap.md``).
+from unknown start poses (docs/design.md's method 2, ``docs/roadmap.md``).
 
 Episodes (all through the sweep runner, in the results folder), per seed:
 
@@ -33,9 +33,20 @@ Figures (simulator ground truth, evaluation only):
   ``roadmap.room.reference_stamp`` (:class:`~experiments.eval.trajectory.TrueTrajectory`: exact,
   the robot stands still when it takes an image); position (m) and heading (deg) errors; within
   the issue's thresholds when <= 0.15 m and <= 5 deg;
-- per learn: targets found, whether the graph is connected, its edges, sim and wall time;
+- per learn: targets found, whether the graph is connected, its edges, sim and wall time; it
+  **succeeded** when the mission did, without a collision;
 - per goto: the report's true final pose against the goal's true pose; **reached** when the
-  mission succeeded and ended within 0.15 m and 5 deg of it.
+  mission succeeded without a collision and ended within 0.15 m and 5 deg of it;
+- per run: ``collisions`` (ground truth), ``safety_stops`` (the collision monitor's),
+  ``min_clearance_m`` (ground truth, when the simulator reports it), summed (the smallest
+  clearance) over the learns and over the gotos.
+
+People (``--option people=N``, :mod:`experiments.eval.people`): N people drawn from the seed,
+standing on or walking across the straight lines between the seed's targets, none within 1 m of a
+target, the start or a navigation's start, are added to a copy of the seed's world file
+(``seeds/<world>_s<seed>/people/<world>.yaml``) that the seed's navigations run in; the target
+images and the learning see the world as it is. The figures record the people placed
+(``people.placed``, ``people.paths``).
 
 An episode that fails, crashes or times out is a run with its status and reason (``failures``);
 a learn without a report found nothing and has no navigations. Roadmap files are written by the
@@ -55,7 +66,8 @@ import numpy as np
 from drivers.sim.floor import FloorGrid
 from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
-from experiments.eval.figures import cell, mean_present
+from experiments.eval import people as crowd
+from experiments.eval.figures import cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.roadmap_world import (
     place_targets,
     pose_error,
@@ -80,6 +92,7 @@ OPTIONS = {
                "of targets placed in the free space from the seed (default: every named pose the robot can stand "
                "at and reach from the start; 4 placed when fewer than 2)",
     "starts": f"random start poses per seed to navigate from (default {DEFAULT_STARTS}; 0: learning only)",
+    crowd.OPTION: crowd.HELP + " (the navigations': between the targets)",
 }
 LEARN, GOTO = "learn_targets", "goto_target"
 POSITION_OK, HEADING_OK = 0.15, 5.0  # m, deg: the issue's thresholds for a target and a navigation
@@ -97,6 +110,7 @@ class Settings:
     targets: tuple[str, ...]
     starts: int
     source: str = NAMED
+    people: int = 0  # people in the navigations' world
 
 
 @dataclass(frozen=True)
@@ -148,7 +162,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     starts = parse_starts(extra.get("starts"))
     if starts:
         random_starts(loaded, 1, 0, grid=grid)  # ValueError: nowhere clear enough to start from
-    return Settings(targets, starts, source)
+    return Settings(targets, starts, source, crowd.parse_people(extra.get(crowd.OPTION)))
 
 
 def choose_targets(text: str | None, world: World, usable: Mapping[str, Pose2D]) -> tuple[tuple[str, ...], str]:
@@ -240,9 +254,10 @@ def learn_episode(world: str, seed: int, folder: Path, max_time_s: float | None)
 
 
 def goto_plans(learn: Episode, world: World, found: Sequence[str], starts: int,
-               max_time_s: float | None, grid: FloorGrid | None = None) -> list[GotoPlan]:
+               max_time_s: float | None, grid: FloorGrid | None = None, run_in: str | None = None) -> list[GotoPlan]:
     """The seed's navigations: random starts (``random_starts``), goals drawn among ``found``; the
-    mission's own ``seed`` (its random moves) is the navigation's number."""
+    mission's own ``seed`` (its random moves) is the navigation's number. They run in the world
+    file ``run_in`` (default: the learning's)."""
     poses = random_starts(world, starts, learn.seed, grid=grid)
     rng = np.random.default_rng([learn.seed, 0x60A2])
     goals = [found[int(i)] for i in rng.integers(len(found), size=starts)] if found else []
@@ -250,8 +265,26 @@ def goto_plans(learn: Episode, world: World, found: Sequence[str], starts: int,
     for k, (start, goal) in enumerate(zip(poses, goals, strict=True)):
         where = f"{start.x:.4f},{start.y:.4f},{math.degrees(start.theta):.3f}deg"
         inputs = {"roadmap": learn.inputs["roadmap"], "target": goal, "seed": k}
-        plans.append(GotoPlan(Episode(GOTO, learn.world, learn.seed, inputs, max_time_s, where), start, goal))
+        plans.append(GotoPlan(Episode(GOTO, run_in or learn.world, learn.seed, inputs, max_time_s, where), start, goal))
     return plans
+
+
+def navigation_worlds(loaded: World, settings: Settings, targets: Mapping[int, SeedTargets], folder: Path,
+                      grid: FloorGrid | None) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
+    """Per seed, the world its navigations run in (with ``settings.people`` people between the
+    targets: module docstring) and those people; the seed's world itself when there are none."""
+    if not settings.people:
+        return {seed: t.world for seed, t in targets.items()}, {}
+    worlds, people = {}, {}
+    for seed, t in targets.items():
+        spots = [(p.x, p.y) for p in t.poses.values()]
+        ways = [np.array([a, b]) for i, a in enumerate(spots) for b in spots[i + 1:]]
+        clear = [*spots, (loaded.start.x, loaded.start.y),
+                 *((p.x, p.y) for p in random_starts(loaded, settings.starts, seed, grid=grid))]
+        people[seed] = crowd.on_ways(loaded, ways, settings.people, seed, keep_clear=clear)
+        here = seed_folder(folder, t.world, seed) / "people" / f"{Path(world_path(t.world)).stem}.yaml"
+        worlds[seed] = str(crowd.world_with_people(t.world, here, people[seed]))
+    return worlds, people
 
 
 def _outcome(report: Mapping[str, Any] | None, row: Mapping[str, Any] | None) -> dict[str, Any]:
@@ -280,7 +313,8 @@ def learn_figures(seed: int, report: Mapping[str, Any] | None, row: Mapping[str,
     """The figures of one learn run against the true poses of its targets (``truth``)."""
     out: dict[str, Any] = {"episode": "learn", "seed": seed, **_outcome(report, row), "targets": len(truth),
                            "found": 0, "target_errors": {}, "within": 0, "connected": False, "edges": 0,
-                           "sim_time_s": None, "wall_time_s": row.get("elapsed_s") if row else None}
+                           "sim_time_s": None, "wall_time_s": row.get("elapsed_s") if row else None,
+                           **safety_figures(report)}
     if report is None:
         return out
     section = report.get("roadmap", {})
@@ -306,7 +340,8 @@ def goto_figures(plan: GotoPlan, report: Mapping[str, Any] | None, row: Mapping[
     out: dict[str, Any] = {"episode": "goto", "seed": plan.episode.seed, "number": plan.episode.inputs["seed"],
                            "start": [round(start.x, 3), round(start.y, 3), round(math.degrees(start.theta), 1)],
                            "goal": plan.goal, **_outcome(report, row), "reached": False, "error_m": None,
-                           "error_deg": None, "sim_time_s": None, "wall_time_s": row.get("elapsed_s") if row else None}
+                           "error_deg": None, "sim_time_s": None, "wall_time_s": row.get("elapsed_s") if row else None,
+                           **safety_figures(report)}
     if report is None or "ground_truth" not in report:
         return out
     final = report["ground_truth"]["final_pose"]
@@ -314,7 +349,8 @@ def goto_figures(plan: GotoPlan, report: Mapping[str, Any] | None, row: Mapping[
     navigation = report.get("roadmap", {}).get("navigation", {})
     out.update({
         "error_m": round(distance, 4), "error_deg": round(heading, 3),
-        "reached": bool(out["status"] == "SUCCESS" and distance <= POSITION_OK and heading <= HEADING_OK),
+        "reached": bool(out["status"] == "SUCCESS" and out["collisions"] == 0 and distance <= POSITION_OK
+                        and heading <= HEADING_OK),
         "visited": navigation.get("visited"), "random_moves": navigation.get("random_moves"),
         "sim_time_s": report.get("sim_time_s"), "wall_time_s": report.get("wall_time_s", out["wall_time_s"]),
     })
@@ -346,8 +382,8 @@ def summarise(world: str, settings: Settings, learns: list[dict[str, Any]], goto
         "targets.source": settings.source,
         "targets.poses": pose_rows(poses or {}),
         "starts": settings.starts,
-        "criterion": f"within {POSITION_OK:g} m and {HEADING_OK:g} deg (a goto: and SUCCESS)",
-        "learn.succeeded": sum(run["status"] == "SUCCESS" for run in learns),
+        "criterion": f"within {POSITION_OK:g} m and {HEADING_OK:g} deg (a goto: and SUCCESS); a run: no collision",
+        "learn.succeeded": sum(run["status"] == "SUCCESS" and not run.get("collisions") for run in learns),
         "targets.found": sum(run["found"] for run in learns),
         "targets.total": len(settings.targets) * len(learns),
         "targets.within": sum(run["within"] for run in learns),
@@ -367,6 +403,8 @@ def summarise(world: str, settings: Settings, learns: list[dict[str, Any]], goto
         "goto.heading_error_mean_deg": mean_present([g["error_deg"] for g in measured]),
         "learn.sim_time_s": mean_present([run["sim_time_s"] for run in learns]),
         "learn.wall_time_s": mean_present([run["wall_time_s"] for run in learns]),
+        **{f"learn.{k}": v for k, v in safety_totals(learns).items()},
+        **{f"goto.{k}": v for k, v in safety_totals(gotos).items()},
     }
     out["failures"] = [_failure(run) for run in [*learns, *gotos] if run["status"] != "SUCCESS"]
     out["runs"] = [*learns, *gotos]
@@ -400,6 +438,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     grid = reachable_grid(loaded)  # once: every seed's placed targets and random starts
     targets = {seed: seed_targets(world, loaded, settings, seed, folder, grid) for seed in options.seeds}
     truth = {seed: t.poses for seed, t in targets.items()}
+    navigate_in, people = navigation_worlds(loaded, settings, targets, folder, grid)
     episodes, rows = _learn_phase(options, targets, settings, folder, resume)
     learns, plans = [], []
     for seed, episode in sorted(episodes.items()):
@@ -407,7 +446,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         learns.append(figures)
         found = sorted(figures["target_errors"])
         if settings.starts and found and Path(episode.inputs["roadmap"]).is_file():
-            plans += goto_plans(episode, loaded, found, settings.starts, options.max_time_s, grid)
+            plans += goto_plans(episode, loaded, found, settings.starts, options.max_time_s, grid, navigate_in[seed])
     rows = {}
     if plans:  # every navigation at once: the pool runs them in parallel
         done = run_sweep([p.episode for p in plans], executor=options.executor, results_dir=folder,
@@ -415,7 +454,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         rows = {row["id"]: row for row in done}
     gotos = [goto_figures(p, read_report(folder, p.episode.id), rows.get(p.episode.id), truth[p.episode.seed][p.goal])
              for p in plans]
-    return summarise(loaded.name, settings, learns, gotos, truth)
+    out = summarise(loaded.name, settings, learns, gotos, truth)
+    return {**out, **crowd.figures(people, settings.people)} if settings.people else out
 
 
 # ------------------------------------------------------------------------------------------------
@@ -434,7 +474,7 @@ def format_table(figures: Mapping[str, Any]) -> str:
         f"roadmap in {f['world']}: {f['seeds']} seed(s), targets {', '.join(f['targets'])} "
         f"({f.get('targets.source', NAMED)}), {f['starts']} goto start(s) per seed; {f['criterion']}",
         f"learn: {f['learn.succeeded']} of {f['seeds']} succeeded; sim {cell(f['learn.sim_time_s'], 0)} s, wall "
-        f"{cell(f['learn.wall_time_s'], 0)} s (means)",
+        f"{cell(f['learn.wall_time_s'], 0)} s (means); {safety_cells(_prefixed(f, 'learn.'))}",
         f"targets found {f['targets.found']} of {f['targets.total']}, within {f['targets.within']}; error worst "
         f"{_pair(f['targets.position_error_worst_m'], f['targets.heading_error_worst_deg'])}, mean "
         f"{_pair(f['targets.position_error_mean_m'], f['targets.heading_error_mean_deg'])}",
@@ -442,15 +482,16 @@ def format_table(figures: Mapping[str, Any]) -> str:
         "edges (mean)",
         f"goto reached {f['goto.reached']} of {f['goto.run']} run ({f['goto.planned']} planned, rate "
         f"{cell(rate, 2)}); error worst {_pair(f['goto.error_worst_m'], f['goto.heading_error_worst_deg'])}, mean "
-        f"{_pair(f['goto.error_mean_m'], f['goto.heading_error_mean_deg'])}",
+        f"{_pair(f['goto.error_mean_m'], f['goto.heading_error_mean_deg'])}; {safety_cells(_prefixed(f, 'goto.'))}",
         "",
-        f"{'seed':>4} {'run':<18} {'status':<8} {'result':<38} {'error':<24} {'sim s':>7} {'wall s':>7}",
+        f"{'seed':>4} {'run':<18} {'status':<8} {'result':<38} {'error':<24} {'sim s':>7} {'wall s':>7}  obstacles",
     ]
     lines += [_run_line(run) for run in f["runs"]]
     if f.get("targets.source") == PLACED:
         lines += [f"seed {seed} placed targets: " + ", ".join(f"{n} ({x:g}, {y:g}, {deg:g} deg)"
                                                                for n, (x, y, deg) in by_name.items())
                   for seed, by_name in f["targets.poses"].items()]
+    lines += crowd.table_line(f)
     lines += [f"seed {x['seed']} {x['episode']}: {x['status']}: {x['reason']}" for x in f["failures"]]
     return "\n".join(lines)
 
@@ -468,4 +509,8 @@ def _run_line(run: Mapping[str, Any]) -> str:
         result = "reached" if run["reached"] else "not reached"
         error = _pair(run["error_m"], run["error_deg"]) if run["error_m"] is not None else "-"
     return (f"{run['seed']:>4} {what:<18} {run['status']:<8} {result:<38} {error:<24} "
-            f"{cell(run['sim_time_s'], 0):>7} {cell(run['wall_time_s'], 0):>7}")
+            f"{cell(run['sim_time_s'], 0):>7} {cell(run['wall_time_s'], 0):>7}  {safety_cells(run)}")
+
+
+def _prefixed(figures: Mapping[str, Any], prefix: str) -> dict[str, Any]:
+    return {k[len(prefix):]: v for k, v in figures.items() if k.startswith(prefix)}

@@ -1,5 +1,12 @@
-"""Summaries of a results table: per parameter combination, the success rate and the mean and spread
-of every numeric figure; a printed table; a plot of one figure against one swept parameter.
+"""Summaries of a results table: per parameter combination, the success rate, the commonest reasons
+of the runs that did not succeed, and the mean and spread of every numeric figure; a printed table
+(with the reasons under it: a sweep whose runs fail says why without opening ``results.jsonl``);
+a plot of one figure against one swept parameter.
+
+Collisions decide success: an episode succeeded when its mission ended in SUCCESS *and* the
+simulator counted no collision (``ground_truth.collisions``); a SUCCESS that touched something is
+counted in ``collided`` (with every other episode that collided), not in ``success``. The printed
+table shows the collided episodes, the collision monitor's stops and the true minimum clearance.
 
 A parameter combination is everything that defines an episode except its seed: mission, world,
 ``max_time_s`` and every ``inputs.<name>``. The spread is the sample standard deviation (0 for a
@@ -10,6 +17,7 @@ from __future__ import annotations
 
 import json
 import statistics
+from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -20,8 +28,30 @@ Row = dict[str, Any]
 
 GROUP_KEYS = ("mission", "world", "max_time_s")
 NOT_FIGURES = frozenset({"id", "seed", "exit_code", "max_time_s"})
-HEADLINE = ("sim_time_s", "ground_truth.goal_error_m", "ground_truth.path_error_m", "ground_truth.trajectory_length_m")
+HEADLINE = ("sim_time_s", "ground_truth.goal_error_m", "ground_truth.path_error_m", "ground_truth.trajectory_length_m",
+            "safety.safety_stops", "ground_truth.min_clearance_m")
 """Figures the printed table shows when they exist (every figure is in summary.json)."""
+REASONS = 3
+"""The commonest reasons of failure kept per parameter combination."""
+COLLISIONS = "ground_truth.collisions"
+
+
+def collided(row: Row) -> bool:
+    """Did the episode touch anything (the simulator's ground truth)?"""
+    count = row.get(COLLISIONS, 0)
+    return is_number(count) and count > 0
+
+
+def succeeded(row: Row) -> bool:
+    """SUCCESS without a collision."""
+    return row.get("status") == "SUCCESS" and not collided(row)
+
+
+def failure_reason(row: Row) -> str:
+    """Why an episode did not succeed: its reason, or that it collided although its mission succeeded."""
+    if row.get("status") == "SUCCESS":
+        return "the mission succeeded but the robot collided"
+    return str(row.get("reason") or row.get("error") or "no reason")
 
 
 def parameter_keys(rows: Sequence[Row]) -> list[str]:
@@ -38,8 +68,11 @@ def figure_keys(rows: Sequence[Row]) -> list[str]:
 
 
 def summarise(rows: Sequence[Row]) -> list[dict[str, Any]]:
-    """One entry per parameter combination: its parameters, ``episodes``, ``success``,
-    ``failure``, ``error``, ``success_rate`` and ``figures`` {name: {n, mean, std, min, max}}."""
+    """One entry per parameter combination: its parameters, ``episodes``, ``success`` (SUCCESS
+    without a collision), ``failure``, ``error``, ``collided`` (episodes with a collision, whatever
+    their status), ``success_rate``, ``reasons`` (the commonest reasons of the runs that did not
+    succeed, ``[{reason, count}]``, most frequent first) and ``figures`` {name: {n, mean, std, min,
+    max}}."""
     params = parameter_keys(rows)
     figures = figure_keys(rows)
     groups: dict[str, list[Row]] = {}
@@ -50,42 +83,68 @@ def summarise(rows: Sequence[Row]) -> list[dict[str, Any]]:
     for members in groups.values():
         entry: dict[str, Any] = {k: members[0].get(k) for k in params}
         statuses = [m.get("status") for m in members]
-        entry.update(episodes=len(members), success=statuses.count("SUCCESS"), failure=statuses.count("FAILURE"),
-                     error=len(members) - statuses.count("SUCCESS") - statuses.count("FAILURE"))
+        entry.update(episodes=len(members), success=sum(succeeded(m) for m in members),
+                     failure=statuses.count("FAILURE"),
+                     error=len(members) - statuses.count("SUCCESS") - statuses.count("FAILURE"),
+                     collided=sum(collided(m) for m in members))
         entry["success_rate"] = entry["success"] / len(members)
+        why = Counter(failure_reason(m) for m in members if not succeeded(m))
+        entry["reasons"] = [{"reason": reason, "count": count} for reason, count in why.most_common(REASONS)]
         entry["figures"] = {}
         for name in figures:
             values = [m[name] for m in members if is_number(m.get(name))]
             if values:
-                entry["figures"][name] = {
-                    "n": len(values), "mean": statistics.fmean(values),
-                    "std": statistics.stdev(values) if len(values) > 1 else 0.0,
-                    "min": min(values), "max": max(values),
-                }
+                mean, std = mean_and_spread(values)
+                entry["figures"][name] = {"n": len(values), "mean": mean, "std": std,
+                                          "min": min(values), "max": max(values)}
         out.append(entry)
     return sorted(out, key=lambda e: [_order(e[k]) for k in params])
+
+
+def mean_and_spread(values: Sequence[float]) -> tuple[float, float]:
+    """Mean and sample standard deviation (0 for one value) of finite numbers, whatever their size:
+    computed on the values divided by the largest magnitude, so 1e308 figures do not overflow."""
+    scale = max(abs(float(v)) for v in values) or 1.0
+    scaled = [float(v) / scale for v in values]
+    spread = statistics.stdev(scaled) if len(scaled) > 1 else 0.0
+    return statistics.fmean(scaled) * scale, spread * scale  # an inf spread becomes null in JSON
 
 
 def format_summary(summary: Sequence[dict[str, Any]], figures: Sequence[str] | None = None) -> str:
     """A plain-text table: the parameters that vary, counts, success rate, mean +- std of figures."""
     if not summary:
         return "no results"
-    params = [k for k in summary[0] if k not in ("episodes", "success", "failure", "error", "success_rate", "figures")]
+    params = [k for k in summary[0] if k not in ("episodes", "success", "failure", "error", "collided", "success_rate",
+                                                 "reasons", "figures")]
     varying = [k for k in params if len({json.dumps(e.get(k), default=str) for e in summary}) > 1]
     shown = varying or [k for k in params if summary[0].get(k) is not None][:2]
     present = sorted({name for e in summary for name in e["figures"]})
     figures = [f for f in (_full_name(f, present) for f in figures or HEADLINE) if f]
-    header = [_short(k) for k in shown] + ["runs", "success", "fail", "error"] + [_short(f) for f in figures]
+    counts = ["runs", "success", "fail", "error", "collided"]
+    header = [_short(k) for k in shown] + counts + [_short(f) for f in figures]
     lines = [header]
     for entry in summary:
         cells = [_cell(entry.get(k)) for k in shown]
-        cells += [str(entry["episodes"]), f"{entry['success_rate']:.0%}", str(entry["failure"]), str(entry["error"])]
+        cells += [str(entry["episodes"]), f"{entry['success_rate']:.0%}", str(entry["failure"]), str(entry["error"]),
+                  str(entry.get("collided", 0))]
         for name in figures:
             stats = entry["figures"].get(name)
             cells.append(f"{stats['mean']:.3g} +- {stats['std']:.2g}" if stats else "-")
         lines.append(cells)
     widths = [max(len(line[i]) for line in lines) for i in range(len(header))]
-    return "\n".join("  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip() for line in lines)
+    table = "\n".join("  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip() for line in lines)
+    return table + _format_reasons(summary, shown)
+
+
+def _format_reasons(summary: Sequence[dict[str, Any]], shown: Sequence[str]) -> str:
+    """Under the table, per combination with failed runs: ``lab, 2: 8 x Drive failed: stalled``."""
+    lines = []
+    for entry in summary:
+        if entry.get("reasons"):
+            where = ", ".join(f"{_short(k)}={_cell(entry.get(k))}" for k in shown)
+            said = "; ".join(f"{r['count']} x {r['reason']}" for r in entry["reasons"])
+            lines.append(f"  {where}: {said}")
+    return "\n\nwhy runs did not succeed (commonest first):\n" + "\n".join(lines) if lines else ""
 
 
 def _full_name(name: str, present: Sequence[str]) -> str | None:
@@ -150,14 +209,13 @@ def _plot_line(ax: Any, members: list[Row], figure: str, against: str, position:
                label: str | None) -> None:
     by_x: dict[Any, list[float]] = {}
     for row in members:
-        value = (1.0 if row.get("status") == "SUCCESS" else 0.0) if figure == "success" else row.get(figure)
+        value = (1.0 if succeeded(row) else 0.0) if figure == "success" else row.get(figure)
         if is_number(value):
             by_x.setdefault(position[_key(row.get(against))], []).append(float(value))  # type: ignore[arg-type]
     if not by_x:
         return
     xs = sorted(by_x)
-    means = [statistics.fmean(by_x[x]) for x in xs]
-    stds = [statistics.stdev(by_x[x]) if len(by_x[x]) > 1 else 0.0 for x in xs]
+    means, stds = zip(*(mean_and_spread(by_x[x]) for x in xs), strict=True)
     line = ax.errorbar(xs, means, yerr=stds, marker="o", capsize=3, label=label)
     scatter_x = [x for x in xs for _ in by_x[x]]
     scatter_y = [v for x in xs for v in by_x[x]]
@@ -177,7 +235,7 @@ def _order(value: Any) -> tuple[int, Any]:
 
 
 def _short(key: str) -> str:
-    for prefix in ("inputs.", "ground_truth."):
+    for prefix in ("inputs.", "ground_truth.", "safety."):
         if key.startswith(prefix):
             return key[len(prefix):]
     return key

@@ -7,12 +7,15 @@ import pytest
 from py_trees.common import Status
 
 from behaviours.base import NotSetUp
-from behaviours.sense import SENSE_NODES, GrabFrames, ReadOdometry, ReadPanTilt
+from behaviours.keys import SENSED_KEYS
+from behaviours.registry import NodeType
+from behaviours.sense import SENSE_NODES, GrabFrames, ReadOdometry, ReadPanTilt, ReadRanges
 from behaviours.testing import BehaviourHarness
 from drivers.fake import fake_robot
 from drivers.interfaces import PanTiltState
 from perception.frame import Frame
 from perception.geometry import Pose2D
+from perception.ranges import Bumper, RangeScan, RangeSensor
 
 
 def frame(name: str, stamp: float) -> Frame:
@@ -77,6 +80,48 @@ def test_grab_frames_without_cameras_writes_nothing():
 def test_a_camera_the_robot_lacks_is_refused_at_setup():
     with pytest.raises(KeyError, match="no camera side"):
         BehaviourHarness(GrabFrames(cameras=("front", "side")), robot=fake_robot(cameras=("front",)))
+
+
+class QueuedRanges:
+    """A range source returning the scans a test queued, then None."""
+
+    def __init__(self, *scans: RangeScan | None) -> None:
+        self.scans = list(scans)
+
+    def read(self) -> RangeScan | None:
+        return self.scans.pop(0) if self.scans else None
+
+    def close(self) -> None:
+        pass
+
+
+def scan(stamp: float, front: float) -> RangeScan:
+    return RangeScan((RangeSensor(0.2, 0.0, 0.0),), np.array([front]), stamp, (Bumper(0.25, 0.0, +1),),
+                     np.array([front < 0.05]))
+
+
+def test_read_ranges_copies_the_newest_scan_and_keeps_the_last_when_none_comes():
+    robot = fake_robot()
+    robot.ranges = QueuedRanges(None, scan(0.1, 1.5), scan(0.2, 0.01))
+    harness = BehaviourHarness(ReadRanges(), robot=robot)
+    assert harness.tick() == Status.SUCCESS and harness.read("/robot/ranges") is None  # nothing read yet
+    harness.tick()
+    assert harness.read("/robot/ranges").ranges.tolist() == [1.5]
+    harness.tick()
+    latest = harness.read("/robot/ranges")
+    assert latest.stamp == 0.2 and latest.bumped(+1)
+    harness.tick()  # the source has nothing new: the last scan stays, its stamp tells its age
+    assert harness.read("/robot/ranges").stamp == 0.2
+
+
+def test_read_ranges_does_nothing_on_a_robot_without_range_sensors():
+    harness = BehaviourHarness(ReadRanges(), robot=fake_robot())
+    assert harness.tick() == Status.SUCCESS and harness.read("/robot/ranges") is None
+
+
+def test_the_sensed_keys_the_framework_reads_are_written_by_the_sensing_branch():
+    written = {port.key: port.type for node in SENSE_NODES for port in NodeType.of(node).outputs}
+    assert all(written.get(spec.path) is spec.type for spec in SENSED_KEYS)
 
 
 @pytest.mark.parametrize("node", SENSE_NODES)

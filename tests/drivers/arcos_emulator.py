@@ -26,6 +26,13 @@ into pieces, ``mute`` the SIPs (the link still hears commands), ``drop_link()``,
 on connection replies, ``sync_glitch`` (a wrong echo), ``start_open`` (a robot still open from an
 earlier client, at ``start_baud``), ``honour_hostbaud=False`` (a robot that says it takes HOSTBAUD
 and does not), stalls, bumpers, battery, sonar, e-stop.
+
+Obstacles: the sonar ring is the model's (ARIA's geometry, :mod:`drivers.pioneer_body`: 16
+transducers), reading 5000 mm (no echo) unless ``wall_ahead`` (m) puts a wall across the start
+heading at that distance from the start pose: then each transducer reads the distance along its
+axis to the wall, and a robot whose front reaches the wall stops there with its middle front
+bumper pressed (released when it backs away). Every SIP sent with a bumper pressed is an event
+(``sip_bumpers``), so a test can tell how many SIP cycles a reaction took.
 """
 
 from __future__ import annotations
@@ -44,10 +51,13 @@ from dataclasses import dataclass
 
 from drivers import arcos
 from drivers.arcos import Command, Identity
+from drivers.pioneer_body import BODIES
 from tests.drivers.emulator_thread import EmulatorThread
 
 SPEED_GRACE_S = 0.1  # a pty carries no speed per byte: bytes read this soon after a speed change still count
 SONARS_PER_SIP = 4  # readings in a SIP when none changed: the robot fires its sonars in turn
+NO_ECHO_MM = 5000  # what the sonar reads when nothing answers (MobileSim's maximum)
+MIDDLE_FRONT_BUMPER = 0b00100  # bumper 2 of 5
 BAUDS = {code: baud for baud, code in arcos.BAUD_CODES.items()}
 
 
@@ -71,6 +81,7 @@ class ArcosEmulator(EmulatorThread):
         self.transport = transport
         self.mode = mode or ("mobilesim" if transport == "tcp" else "firmware")
         self.params = arcos.MODELS[model]
+        self.body = BODIES[model]
         name = "MobileSim" if self.mode == "mobilesim" else "emulator"
         self.identity = identity or Identity(name, "Pioneer", model)
         self.sip_period = sip_period
@@ -103,9 +114,11 @@ class ArcosEmulator(EmulatorThread):
         self.stall_left = self.stall_right = False
         self.front_bumpers = self.rear_bumpers = 0
         self.battery = 12.6  # V
-        self.sonar_ranges: dict[int, int] = {i: 5000 for i in range(8)}  # mm
+        self.sonar_ranges: dict[int, int] = {i: NO_ECHO_MM for i in range(len(self.body.sonar))}  # mm
         self._sonar_dirty = set(self.sonar_ranges)
         self._next_sonar = 0
+        self.wall_ahead: float | None = None  # m from the start pose along its heading
+        self.silent_sonar: set[int] = set()  # transducers that never report
 
     def _init_protocol(self, *, start_open: bool, start_baud: int, sync_glitch: int) -> None:
         self.state = "open" if start_open else "sync0"
@@ -260,6 +273,38 @@ class ArcosEmulator(EmulatorThread):
             self.x += r * (math.sin(self.theta + w * dt) - math.sin(self.theta))
             self.y -= r * (math.cos(self.theta + w * dt) - math.cos(self.theta))
         self.theta = _wrap(self.theta + w * dt)
+        self._touch_wall()
+
+    def _touch_wall(self) -> None:
+        """A front that reaches the wall stays at it, the middle front bumper pressed (until it backs off)."""
+        if self.wall_ahead is None:
+            return
+        x, _, theta = _relative((self.x, self.y, self.theta), self.start_pose)
+        front = x + self.body.length_front * 1000.0 * math.cos(theta)
+        wall = self.wall_ahead * 1000.0
+        if front >= wall:
+            back = front - wall
+            c, s = math.cos(self.start_pose[2]), math.sin(self.start_pose[2])
+            self.x, self.y = self.x - back * c, self.y - back * s
+            self.front_bumpers |= MIDDLE_FRONT_BUMPER
+        elif front < wall - 5.0:
+            self.front_bumpers &= ~MIDDLE_FRONT_BUMPER
+
+    def _sense_wall(self) -> None:
+        """Each transducer's range along its axis to the wall (no echo beyond 5 m or facing away)."""
+        if self.wall_ahead is None:
+            return
+        x, y, theta = _relative((self.x, self.y, self.theta), self.start_pose)
+        c, s = math.cos(theta), math.sin(theta)
+        for index, (sx, sy, heading) in enumerate(self.body.sonar):
+            along = x + c * sx - s * sy  # the transducer's distance along the start heading, mm
+            facing = math.cos(theta + math.radians(heading))
+            reading = NO_ECHO_MM
+            if facing > 1e-6:
+                reading = min(NO_ECHO_MM, int(round((self.wall_ahead * 1000.0 - along) / facing)))
+            if reading != self.sonar_ranges[index]:
+                self.sonar_ranges[index] = reading
+                self._sonar_dirty.add(index)
 
     def _handle(self, payload: bytes, now: float) -> None:
         try:
@@ -373,13 +418,19 @@ class ArcosEmulator(EmulatorThread):
     # -- output ------------------------------------------------------------------------------------
     def _send_sip(self) -> None:
         l_vel, r_vel = self._wheel_speeds()
+        self._sense_wall()
         sonar = []
-        for index in sorted(self._sonar_dirty)[:8]:  # a changed range first, then the firing sequence goes on
+        for index in sorted(self._sonar_dirty - self.silent_sonar)[:8]:  # a changed range first, then in turn
             sonar.append((index, self.sonar_ranges[index]))
             self._sonar_dirty.discard(index)
-        while len(sonar) < SONARS_PER_SIP:
+        for _ in range(len(self.sonar_ranges)):
+            if len(sonar) >= SONARS_PER_SIP:
+                break
             self._next_sonar = (self._next_sonar + 1) % len(self.sonar_ranges)
-            sonar.append((self._next_sonar, self.sonar_ranges[self._next_sonar]))
+            if self._next_sonar not in self.silent_sonar:
+                sonar.append((self._next_sonar, self.sonar_ranges[self._next_sonar]))
+        if self.front_bumpers or self.rear_bumpers:
+            self.events.append(Event(time.monotonic(), "sip_bumpers", self.front_bumpers | self.rear_bumpers << 8))
         low = int(self.stall_left) | (self.rear_bumpers << 1)
         high = int(self.stall_right) | (self.front_bumpers << 1)
         stall = low | (high << 8)

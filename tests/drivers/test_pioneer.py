@@ -44,7 +44,7 @@ def test_connects_and_reports_what_the_robot_said(base, transport):
     status = pioneer.status()
     assert status.motors_enabled and not status.estop and not pioneer.stalled()
     assert pioneer.battery() == pytest.approx(12.6)
-    assert emulator.wait_for(lambda: len(pioneer.sonar()) == 8)
+    assert emulator.wait_for(lambda: len(pioneer.sonar()) == 16)  # the P3-DX ring of ARIA's params/p3dx.p
     assert set(pioneer.sonar().values()) == {5.0}
     steps = [e.name for e in emulator.events if e.name in ("OPEN", "CONFIG", "HOSTBAUD", "SONAR", "ENABLE")]
     serial_link = transport == "pty"  # MobileSim's TCP has no speed to switch

@@ -11,6 +11,7 @@ import pytest
 
 from drivers.sim.world import load_world
 from experiments.eval.exploration import (
+    Settings,
     check_options,
     check_world,
     episode_figures,
@@ -98,13 +99,13 @@ def test_three_variants_per_seed():
 
 
 def test_the_localisation_option_names_the_oracle_beside_the_visual(tmp_path):
-    assert check_options("lab", {}) == ("visual",)
-    assert check_options("lab", {"localisation": "visual,ideal"}) == ("visual", "ideal")
+    assert check_options("lab", {}) == Settings(("visual",), 0)
+    assert check_options("lab", {"localisation": "visual,ideal", "people": "2"}) == Settings(("visual", "ideal"), 2)
     with pytest.raises(ValueError, match="visual, ideal or visual,ideal"):
         check_options("lab", {"localisation": "gps"})
     stereo_only = tmp_path / "stereo_only.yaml"
     stereo_only.write_text(Path(BOX).read_text() + "cameras:\n  - {name: stereo, kind: stereo, mount: ptu}\n")
-    assert check_options(str(stereo_only), {"localisation": "visual"}) == ("visual",)
+    assert check_options(str(stereo_only), {"localisation": "visual"}).localisations == ("visual",)
     with pytest.raises(ValueError, match="localisation ideal needs the camera 'landmarks'"):
         check_options(str(stereo_only), {"localisation": "visual,ideal"})
     runs = episodes("lab", [0], localisations=("visual", "ideal"))

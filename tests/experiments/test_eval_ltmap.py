@@ -129,6 +129,11 @@ def test_viewframes_are_matched_through_times_and_sources():
     assert figures["reached"] and figures["viewframes_reached"] == 1.0
     assert not repeat_figures(taught, repeat, level, tolerance=0.05)["reached"]
     assert not repeat_figures(taught, {**repeat, "status": "FAILURE"}, level, tolerance=0.5)["reached"]
+    touched = {**repeat, "ground_truth": {**repeat["ground_truth"], "collisions": 1, "min_clearance_m": 0.0},
+               "safety": {"safety_stops": 2}}  # home, but it touched something on the way: not reached
+    collided = repeat_figures(taught, touched, level, tolerance=0.5)
+    assert not collided["reached"] and (collided["collisions"], collided["safety_stops"]) == (1, 2)
+    assert (figures["collisions"], figures["safety_stops"], figures["min_clearance_m"]) == (0, 0, None)
     assert repeat_figures(taught, None, level, tolerance=0.5) | {"reached": False} == {
         "cut": 1, "height": 1, "viewframes": 2, "landmarks": 40, "bytes": 900, "memory_fraction": 0.5,
         "status": "ERROR", "reached": False}
@@ -148,6 +153,7 @@ def test_the_evaluation_on_a_small_world_file(world_file, tmp_path, capsys):
     assert all(a["memory_pct"] > b["memory_pct"] for a, b in zip(rows[:-1], rows[1:], strict=True))
     assert rows[0]["height"] == figures["teach.height"] and rows[-1]["height"] == 0
     assert figures["full.goal_reached"] == 1 and figures["full.path_error_m"] < 0.2  # the full tree leads home
+    assert figures["full.collisions"] == 0 and figures["teach.collisions"] == 0
     assert figures["full.viewframe_error_m"] < 0.6
     assert all(r["map_as_expected"] for r in figures["runs"]) and "warning" not in figures
     assert len((out / "results.jsonl").read_text().splitlines()) == 1 + len(rows)  # a teach, a repeat per height
@@ -156,7 +162,10 @@ def test_the_evaluation_on_a_small_world_file(world_file, tmp_path, capsys):
     assert main([*args, "--resume"]) == 0
     table = capsys.readouterr().out
     assert "small_room" in table and "goal reached by every seed down to" in table
-    assert len(table.splitlines()) == 4 + len(rows)
+    teaching = next(line for line in table.splitlines() if line.startswith("teaching: "))
+    clearance = float(teaching.split("clear ")[1])  # the closest the robot's disc came to anything
+    assert teaching.startswith("teaching: 0 coll, 0 stops, clear ") and 0.05 < clearance < 1.0
+    assert len(table.splitlines()) == 5 + len(rows)
     assert len((out / "results.jsonl").read_text().splitlines()) == 1 + len(rows)
     assert format_table(figures) == table.rstrip("\n")
 

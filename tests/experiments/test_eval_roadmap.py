@@ -266,6 +266,10 @@ def test_a_navigation_is_reached_when_it_succeeds_within_the_thresholds():
     assert not goto_figures(*_goto("SUCCESS", Pose2D(2.0, 3.1, math.radians(96))), goal)["reached"]  # 6 deg
     assert not goto_figures(*_goto("SUCCESS", Pose2D(2.2, 3.0, math.radians(90))), goal)["reached"]  # 0.2 m
     assert not goto_figures(*_goto("FAILURE", goal), goal)["reached"]  # there by chance, the mission failed
+    plan, report, row = _goto("SUCCESS", Pose2D(2.0, 3.1, math.radians(93)))
+    report["ground_truth"]["collisions"] = 2  # it touched a desk twice on the way and printed SUCCESS
+    touched = goto_figures(plan, report, row, goal)
+    assert not touched["reached"] and touched["collisions"] == 2
     plan, _, _ = _goto("ERROR", None)
     killed = goto_figures(plan, None, {"status": "ERROR", "reason": "killed by SIGKILL", "elapsed_s": 3.0}, goal)
     assert killed["status"] == "ERROR" and killed["error_m"] is None and not killed["reached"]
@@ -300,6 +304,10 @@ def test_the_summary_from_hand_made_runs():
     assert figures["goto.reached_rate"] == pytest.approx(1 / 3)
     assert figures["goto.error_worst_m"] == 1.5 and figures["goto.error_mean_m"] == pytest.approx(0.755)
     assert figures["learn.succeeded"] == 1 and figures["learn.sim_time_s"] == 800.0
+    assert (figures["goto.collisions"], figures["goto.safety_stops"], figures["goto.min_clearance_m"]) == (0, 0, None)
+    bumped = summarise("w", settings, [{**learns[0], "collisions": 1, "safety_stops": 3, "min_clearance_m": 0.0}], [])
+    assert bumped["learn.succeeded"] == 0 and bumped["learn.collisions"] == 1 and bumped["learn.safety_stops"] == 3
+    assert "1 coll, 3 stops, clear 0.00" in format_table(bumped)
     assert [f["episode"] for f in figures["failures"]] == ["learn", "goto 1 to b", "goto 0 to a"]
     assert figures["failures"][1]["reason"] == "killed by SIGKILL" and len(figures["runs"]) == 5
     table = format_table(figures)

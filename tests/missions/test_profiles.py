@@ -6,9 +6,11 @@ import sys
 
 import pytest
 
+from drivers.fake import FakeBase
+from drivers.interfaces import Robot
 from maps.store import InputError
 from missions.cli import main
-from missions.profiles import PROFILES, load_profile
+from missions.profiles import PROFILES, load_profile, robot_safety
 
 
 @pytest.mark.parametrize("path", sorted(PROFILES.glob("*.yaml")), ids=lambda p: p.stem)
@@ -16,9 +18,9 @@ def test_shipped_profiles_are_valid_and_need_their_hardware(path, capsys):
     name, devices = load_profile(path)
     assert devices[0].role == "base" and devices[0].driver == "pioneer"
     assert all(d.settings.name == d.name for d in devices if d.role == "camera")  # frames carry the profile's name
-    assert main(["run", "square", "--robot", str(path), "--quiet"]) == 2  # no robot on this machine
+    assert main(["run", "square", "--robot", str(path), "--quiet"]) == 1  # no robot here: a device fault
     err = capsys.readouterr().err
-    assert "cannot open the robot:" in err and "Traceback" not in err
+    assert f"FAILURE (device fault: cannot open the robot of {path}:" in err and "Traceback" not in err
 
 
 def test_driver_settings_errors_are_located_in_the_profile(tmp_path):
@@ -40,7 +42,7 @@ def test_profile_shape_errors(tmp_path):
     messages = sorted((d.line, d.message) for d in info.value.diagnostics)
     assert messages == [
         (3, "cameras: input should be a valid dictionary, got a list of 1"),
-        (4, "unknown key 'wheels' (allowed: base, cameras, description, ptu, robot)"),
+        (4, "unknown key 'wheels' (allowed: base, cameras, description, ptu, robot, safety)"),
     ]
     path.write_text("robot: x\nbase: {driver: pionner}\n")
     with pytest.raises(InputError) as info:
@@ -102,3 +104,28 @@ def test_validate_against_an_invalid_profile_reports_the_profile(tmp_path, capsy
     path.write_text("base: {driver: roomba}\n")
     assert main(["validate", "square", "--robot", str(path)]) == 2
     assert "unknown base driver 'roomba'" in capsys.readouterr().err
+
+
+def test_the_safety_section_is_checked_with_located_errors(tmp_path):
+    path = tmp_path / "robot.yaml"
+    path.write_text("base: {driver: pioneer, port: /dev/ttyUSB0}\nsafety:\n  stop_margin: -1\n"
+                    "  stop_zone: [[1, 1], [2, 1], [2, 2]]\n  crawl_sped: 0.1\n")
+    with pytest.raises(InputError) as info:
+        load_profile(path)
+    found = sorted((d.line, d.col, d.message.split(";")[0]) for d in info.value.diagnostics)
+    assert found == [(3, 16, "safety.stop_margin must be >= 0 m, got -1"),
+                     (4, 14, "safety.stop_zone: the polygon must contain the robot's centre (0, 0)"),
+                     (5, 3, "unknown key 'crawl_sped' in safety")]
+
+
+def test_the_monitor_of_a_robot_grows_its_footprint_and_refuses_a_zone_that_leaves_it_out(tmp_path):
+    path = tmp_path / "robot.yaml"
+    path.write_text("base: {driver: pioneer, port: /dev/ttyUSB0}\nsafety: {stop_margin: 0.2}\n")
+    config = robot_safety(path, Robot(base=FakeBase()))  # a base that does not say its model: a P3-DX's box
+    assert config.zones[0].polygon[:, 0].max() == pytest.approx(0.41)
+    path.write_text("base: {driver: pioneer, port: /dev/ttyUSB0}\n"
+                    "safety:\n  stop_zone: [[0.1, 0.1], [-0.1, 0.1], [-0.1, -0.1], [0.1, -0.1]]\n")
+    with pytest.raises(InputError) as info:
+        robot_safety(path, Robot(base=FakeBase()))
+    assert [(d.line, d.message) for d in info.value.diagnostics] == [
+        (3, "safety: the stop_zone must contain the whole footprint")]

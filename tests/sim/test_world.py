@@ -24,6 +24,20 @@ def test_four_worlds_are_shipped_and_load_by_name() -> None:
     assert max(math.hypot(lm.x - 30, lm.y - 20) for lm in outdoor.landmarks) > 200  # on the horizon
 
 
+def test_the_office_has_people_walking_and_every_frame_shows_them_where_they_are() -> None:
+    sim = Simulation.load("office", seed=0)
+    assert len(sim.world.people) == 3 and all(len(p.path) >= 2 for p in sim.world.people)
+    camera = sim.robot.cameras["panorama"]
+    first = camera.grab()
+    before = sim.people_xy()
+    for _ in range(50):  # 5 s, the robot standing still: only the people move
+        sim.step(0.1)
+    assert (sim.people_xy() != before).any(axis=1).all()
+    later = camera.grab()
+    assert first is not None and later is not None and not (first.image == later.image).all()
+    assert sim.robot.ranges is not None and sim.ground_truth_report()["collisions"] == 0
+
+
 def test_empty_world_is_a_plane_with_the_default_cameras() -> None:
     for name in (None, "empty"):
         sim = Simulation.load(name)

@@ -14,7 +14,8 @@ from tests.fuzzing import examples, load_or_diagnose
 SHIPPED = sorted(p.read_text(encoding="utf-8") for p in shipped_worlds().values())
 KEYS = ["name", "start", "poses", "walls", "boxes", "pillars", "landmarks", "cameras", "ptu", "lighting", "points",
         "height", "texture", "center", "size", "radius", "position", "id", "kind", "mount", "model", "x", "y",
-        "theta_deg", "closed", "seed", "format", "ceiling"]
+        "theta_deg", "closed", "seed", "format", "ceiling", "people", "path", "speed", "wait_s", "loop", "sonar",
+        "robot", "bumpers"]
 SETTINGS = settings(max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 

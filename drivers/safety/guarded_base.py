@@ -1,0 +1,74 @@
+"""A :class:`~drivers.interfaces.Base` that passes every command through the collision monitor.
+
+The runner wraps the robot's base in it before the tree is set up (``missions/runner.py``), on
+the robot and in the simulator alike, whatever the mission: every ``drive(v, w)`` reads the
+newest scan of the robot's :class:`~drivers.interfaces.RangeSource`, asks
+:class:`~perception.collision_monitor.CollisionMonitor` for the limited command, records the
+verdict (:class:`~drivers.safety.log.SafetyLog`) and sends the limited command to the base.
+``stop()`` goes straight through (stopping is always allowed), as do ``odometry()``,
+``stalled()``, ``close()`` and anything else the wrapped driver offers (``status()``,
+``report_sections()``...).
+
+A robot without a range source has nothing to monitor: commands pass unchanged and the log says
+``sources: none``. A source that gives no scan, or an old one, is a blind robot: it crawls.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from drivers.interfaces import Base, RangeSource
+from drivers.safety.log import SafetyLog
+from perception.collision_monitor import CollisionMonitor, SafetyState, Verdict
+from perception.geometry import Pose2D
+from perception.ranges import RangeScan
+
+
+class GuardedBase:
+    """``base`` behind ``monitor``, fed by ``ranges`` and stamped by ``clock`` (the run's clock)."""
+
+    def __init__(self, base: Base, monitor: CollisionMonitor, ranges: RangeSource | None,
+                 clock: Callable[[], float]) -> None:
+        self.base = base
+        self.monitor = monitor
+        self.ranges = ranges
+        self.clock = clock
+        self.state = SafetyState(reason="no command yet")
+        self.scan: RangeScan | None = None
+        self.log = SafetyLog(sources=_describe(ranges))
+
+    def drive(self, v: float, w: float) -> None:
+        """Send ``(v, w)`` limited by the monitor against the newest scan."""
+        now = self.clock()
+        if self.ranges is None:
+            verdict = Verdict(v, w, SafetyState(reason="no range sensors", stamp=now))
+        else:
+            self.scan = self.ranges.read()
+            verdict = self.monitor.check(v, w, self.scan, now)
+        self.state = verdict.state
+        self.log.add(v, w, verdict)
+        self.base.drive(verdict.v, verdict.w)
+
+    def stop(self) -> None:
+        self.base.stop()
+
+    def odometry(self) -> Pose2D:
+        return self.base.odometry()
+
+    def stalled(self) -> bool:
+        return self.base.stalled()
+
+    def close(self) -> None:
+        self.base.close()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.base, name)  # the wrapped driver's own extras (status(), report_sections()...)
+
+
+def _describe(ranges: RangeSource | None) -> str:
+    """What the monitor sees with, for the report (``none``: it sees nothing)."""
+    if ranges is None:
+        return "none"
+    describe = getattr(ranges, "describe", None)
+    return str(describe()) if callable(describe) else type(ranges).__name__

@@ -1,0 +1,209 @@
+"""People in the evaluations' worlds: ``--option people=N`` of every ``bearings eval`` area.
+
+N people are drawn from the seed alone and added to a copy of the world file the area's episodes
+run in (:func:`world_with_people`); nothing else changes, so the same seed gives the same people
+and ``people=0`` (the default) leaves the episodes exactly as they were. Each person is, with
+even odds:
+
+- **standing** on the way the robot is to go, or
+- **crossing** it: walking back and forth across it, square to it, up to :data:`CROSSING` m to
+  each side (cut where a wall, box or pillar comes nearer than the person's radius), at a speed
+  in :data:`SPEEDS`, waiting up to :data:`WAIT_S` s at each end.
+
+Where "the way" is depends on the area: the taught route (``ltmap``), the straight lines between
+the targets (``roadmap``), or anywhere in the rooms (``exploration``: :func:`in_rooms`, a walker
+going to another free point in sight instead of crossing). People keep :data:`KEEP_CLEAR_M` from
+the places given to keep clear (where runs start and end), stand where a person fits (their
+radius from every surface) and apart from each other; a world with no such room for N people
+gets fewer (the count is in the figures: ``people.placed``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from drivers.sim.floor import FloorGrid
+from drivers.sim.scene import Scene
+from drivers.sim.world import World, shipped_worlds
+
+MAX_PEOPLE = 20
+OPTION = "people"
+HELP = (f"N people (0 to {MAX_PEOPLE}, default 0) drawn from the seed, standing on or walking across the way the "
+        "robot goes, added to the world the episodes run in")
+RADIUS = 0.25  # m: the world file's default person
+KEEP_CLEAR_M = 1.0  # m from where runs start and end
+SPACING = 2 * RADIUS + 0.2  # m between two people's centres
+CROSSING = (1.0, 2.0)  # m to each side of the way a crossing person walks
+SPEEDS = (0.5, 1.2)  # m/s
+WAIT_S = 2.0
+WALK = (1.5, 4.0)  # m: how far a walker in a room goes
+DRAWS = 500  # positions tried per person
+STEP = 0.05  # m: how finely a walk is checked against the surfaces
+
+
+def parse_people(text: str | None) -> int:
+    """The ``people`` option: 0 to :data:`MAX_PEOPLE` (default 0); ``ValueError`` otherwise."""
+    if text is None:
+        return 0
+    try:
+        count = int(text)
+    except ValueError:
+        raise ValueError(f"people: an integer expected, got {text!r}") from None
+    if not 0 <= count <= MAX_PEOPLE:
+        raise ValueError(f"people must be 0 to {MAX_PEOPLE}, got {count}")
+    return count
+
+
+@dataclass(frozen=True)
+class Walker:
+    """One person for a world file: where they walk (one point: standing), speed, wait."""
+
+    path: tuple[tuple[float, float], ...]
+    speed: float = 1.0
+    wait_s: float = 0.0
+
+    def entry(self) -> dict[str, Any]:
+        """The person as a world file's ``people:`` entry."""
+        out: dict[str, Any] = {"path": [[round(x, 3), round(y, 3)] for x, y in self.path]}
+        if len(self.path) > 1:
+            out.update(speed=round(self.speed, 3), wait_s=round(self.wait_s, 2))
+        return out
+
+
+class _Placer:
+    """What every placement checks: room for a person, apart from the others, clear of given places."""
+
+    def __init__(self, world: World, keep_clear: Sequence[Sequence[float]]) -> None:
+        self.scene = Scene(world)
+        self.keep_clear = np.asarray(keep_clear, dtype=np.float64).reshape(-1, 2)
+        self.placed: list[Walker] = []
+
+    def fits(self, a: np.ndarray, b: np.ndarray | None = None) -> bool:
+        """Whether a person standing at ``a`` (or walking from ``a`` to ``b``) fits: their radius
+        from every surface all along, :data:`KEEP_CLEAR_M` from the places to keep clear and
+        :data:`SPACING` from everybody placed."""
+        b = a if b is None else b
+        if not self.apart(a, b):
+            return False
+        steps = max(1, math.ceil(float(np.hypot(*(b - a))) / STEP))
+        return all(self.scene.clearance(*(a + (b - a) * (k / steps))) >= RADIUS for k in range(steps + 1))
+
+    def apart(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """Whether the segment a-b keeps clear of the places to keep clear and of everybody placed."""
+        if len(self.keep_clear) and _distances(self.keep_clear, a, b).min() < KEEP_CLEAR_M:
+            return False
+        others = np.array([p for w in self.placed for p in w.path]).reshape(-1, 2)
+        return not (len(others) and _distances(others, a, b).min() < SPACING)
+
+    def reach(self, p: np.ndarray, direction: np.ndarray, most: float) -> float:
+        """How far (up to ``most``) a person can walk from ``p`` along ``direction`` before a surface."""
+        along = 0.0
+        while along + STEP <= most and self.scene.clearance(*(p + direction * (along + STEP))) >= RADIUS:
+            along += STEP
+        return along
+
+
+def _distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance of each point to the segment a-b."""
+    ab = b - a
+    t = np.clip(((points - a) @ ab) / max(float(ab @ ab), 1e-12), 0.0, 1.0)
+    return np.hypot(*(points - (a + t[:, None] * ab)).T)
+
+
+def on_ways(world: World, ways: Sequence[np.ndarray], count: int, seed: int, *,
+            keep_clear: Sequence[Sequence[float]]) -> list[Walker]:
+    """``count`` people standing on or crossing the polylines ``ways`` (world, N x 2 each), drawn
+    from ``seed``: a point uniform along all the ways together, then standing or crossing."""
+    rng = np.random.default_rng([seed, count, 0x9E09])
+    placer = _Placer(world, keep_clear)
+    segments = [(a, b) for way in ways for a, b in zip(way[:-1], way[1:], strict=True) if np.hypot(*(b - a)) > 0]
+    if not segments:
+        return []
+    lengths = np.array([np.hypot(*(b - a)) for a, b in segments])
+    for _ in range(count):
+        for _ in range(DRAWS):
+            k = int(rng.choice(len(segments), p=lengths / lengths.sum()))
+            a, b = segments[k]
+            p = a + (b - a) * rng.uniform()
+            walker = _standing_or_crossing(placer, p, (b - a) / lengths[k], rng)
+            if walker is not None:
+                placer.placed.append(walker)
+                break
+    return placer.placed
+
+
+def _standing_or_crossing(placer: _Placer, p: np.ndarray, along: np.ndarray,
+                          rng: np.random.Generator) -> Walker | None:
+    if rng.uniform() < 0.5:
+        return Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) else None
+    if not placer.apart(p, p):  # the crossing passes through p
+        return None
+    normal = np.array([-along[1], along[0]])
+    left = placer.reach(p, normal, rng.uniform(*CROSSING))
+    right = placer.reach(p, -normal, rng.uniform(*CROSSING))
+    a, b = p - right * normal, p + left * normal
+    if min(left, right) < 2 * RADIUS or not placer.fits(a, b):  # a crossing leaves the way on both sides
+        return None
+    first, last = (a, b) if rng.uniform() < 0.5 else (b, a)
+    return Walker(((float(first[0]), float(first[1])), (float(last[0]), float(last[1]))),
+                  float(rng.uniform(*SPEEDS)), float(rng.uniform(0.0, WAIT_S)))
+
+
+def in_rooms(world: World, grid: FloorGrid, count: int, seed: int, *,
+             keep_clear: Sequence[Sequence[float]]) -> list[Walker]:
+    """``count`` people on the floor the robot reaches (``grid``), drawn from ``seed``: standing, or
+    walking back and forth to another reachable point :data:`WALK` m away in a straight free line."""
+    rng = np.random.default_rng([seed, count, 0x9E0A])
+    placer = _Placer(world, keep_clear)
+    xmin, ymin, xmax, ymax = world.bounds()
+    for _ in range(count):
+        for _ in range(DRAWS):
+            p = np.array([rng.uniform(xmin, xmax), rng.uniform(ymin, ymax)])
+            if not grid.reachable_at(p[None, :])[0]:
+                continue
+            if rng.uniform() < 0.5:
+                walker = Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) else None
+            else:
+                heading = rng.uniform(-math.pi, math.pi)
+                q = p + rng.uniform(*WALK) * np.array([math.cos(heading), math.sin(heading)])
+                on_floor = bool(grid.reachable_at(q[None, :])[0])
+                walker = Walker(((float(p[0]), float(p[1])), (float(q[0]), float(q[1]))), float(rng.uniform(*SPEEDS)),
+                                float(rng.uniform(0.0, WAIT_S))) if on_floor and placer.fits(p, q) else None
+            if walker is not None:
+                placer.placed.append(walker)
+                break
+    return placer.placed
+
+
+def world_with_people(world: str | Path, out: Path, people: Sequence[Walker]) -> Path:
+    """A copy of ``world`` (a shipped world's name or a world file) at ``out`` with ``people`` added
+    to its own."""
+    shipped = shipped_worlds()
+    source = Path(shipped[str(world)]) if str(world) in shipped else Path(world)
+    data = yaml.safe_load(source.read_text())
+    data["people"] = [*data.get("people", []), *(w.entry() for w in people)]
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(yaml.safe_dump(data, sort_keys=False))
+    return out
+
+
+def figures(people: dict[int, list[Walker]], asked: int) -> dict[str, Any]:
+    """What the evaluation records of its people: how many were asked for, placed per seed, and where."""
+    return {"people": asked,
+            "people.placed": {str(seed): len(walkers) for seed, walkers in sorted(people.items())},
+            "people.paths": {str(seed): [w.entry() for w in walkers] for seed, walkers in sorted(people.items())}}
+
+
+def table_line(figures: Mapping[str, Any]) -> list[str]:
+    """The people's line of an area's readable table (none without people)."""
+    if not figures.get(OPTION):
+        return []
+    placed = ", ".join(f"seed {seed}: {n}" for seed, n in figures.get("people.placed", {}).items())
+    return [f"people: {figures[OPTION]} asked per seed, standing on or walking across the way ({placed} placed)"]

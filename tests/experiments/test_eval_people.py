@@ -1,0 +1,196 @@
+"""``--option people=N`` of every ``bearings eval`` area: people drawn from the seed, on or across
+the way the robot goes, in a copy of the world file the episodes run in; people=0 changes nothing."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drivers.sim.floor import reachable_floor
+from drivers.sim.world import load_world
+from experiments.eval import exploration, ltmap, roadmap
+from experiments.eval.people import (
+    KEEP_CLEAR_M,
+    RADIUS,
+    SPACING,
+    Walker,
+    in_rooms,
+    on_ways,
+    parse_people,
+    table_line,
+    world_with_people,
+)
+from experiments.sweep import Episode
+from missions.cli import main
+
+HALL = """
+name: hall
+start: {x: 1.0, y: 2.0, theta_deg: 0}
+walls: [{points: [[0, 0], [10, 0], [10, 4], [0, 4]], closed: true, height: 2.5}]
+boxes: [{center: [5.0, 3.5], size: [1.0, 1.0], height: 0.8}]
+people: [{path: [[9, 3.5]]}]
+"""
+ROUTE = np.array([[1.0, 2.0], [5.0, 2.0], [8.0, 1.0]])
+BOX = str(Path(__file__).resolve().parents[1] / "data" / "worlds" / "box.yaml")
+
+
+def distance_to(way: np.ndarray, point: np.ndarray) -> float:
+    a, b = way[:-1], way[1:]
+    t = np.clip(np.sum((point - a) * (b - a), axis=1) / np.sum((b - a) ** 2, axis=1), 0.0, 1.0)
+    return float(np.min(np.hypot(*(point - (a + t[:, None] * (b - a))).T)))
+
+
+def gap(person: Walker, point: np.ndarray) -> float:
+    """How near a person's path (a point or a segment) comes to ``point``."""
+    path = np.asarray(person.path)
+    return float(np.hypot(*(path[0] - point))) if len(path) == 1 else distance_to(path, point)
+
+
+def crosses(way: np.ndarray, walker: Walker) -> bool:
+    """Whether a walker's segment meets the polyline (sampled every 1/200 of it); a standing one: no."""
+    if len(walker.path) == 1:
+        return False
+    a, b = np.asarray(walker.path)
+    samples = a + np.linspace(0.0, 1.0, 201)[:, None] * (b - a)
+    return min(distance_to(way, p) for p in samples) < 0.03
+
+
+@pytest.mark.parametrize(("text", "count"), [(None, 0), ("0", 0), ("4", 4), ("20", 20)])
+def test_the_option_is_a_count_of_people(text, count):
+    assert parse_people(text) == count
+
+
+@pytest.mark.parametrize(("text", "message"), [("-1", "0 to 20"), ("21", "0 to 20"), ("two", "an integer")])
+def test_a_bad_count_is_refused(text, message):
+    with pytest.raises(ValueError, match=message):
+        parse_people(text)
+
+
+def test_people_stand_on_the_way_or_walk_across_it_clear_of_its_ends(world_file):
+    world = load_world(world_file(HALL))
+    people = on_ways(world, [ROUTE], 6, seed=3, keep_clear=[ROUTE[0], ROUTE[-1]])
+    assert len(people) == 6
+    assert {len(p.path) for p in people} == {1, 2}  # some stand, some walk (this seed: both)
+    for person in people:
+        path = np.asarray(person.path)
+        if len(path) == 1:
+            assert distance_to(ROUTE, path[0]) < 1e-9
+        else:
+            assert crosses(ROUTE, person) and 0.5 <= person.speed <= 1.2 and 0.0 <= person.wait_s <= 2.0
+        for end in (ROUTE[0], ROUTE[-1]):  # 1 m from the route's start and end, all along their paths
+            assert gap(person, end) >= KEEP_CLEAR_M - 1e-9
+    centres = np.array([p.path[0] for p in people if len(p.path) == 1])
+    gaps = np.hypot(*(centres[:, None] - centres[None]).transpose(2, 0, 1))
+    assert np.all(gaps[np.triu_indices(len(centres), 1)] >= SPACING - 1e-9)
+
+
+def test_the_same_seed_draws_the_same_people_and_another_seed_others(world_file):
+    world = load_world(world_file(HALL))
+    draw = [on_ways(world, [ROUTE], 4, seed=s, keep_clear=[ROUTE[0]]) for s in (1, 1, 2)]
+    assert draw[0] == draw[1] and draw[0] != draw[2]
+
+
+def test_people_in_rooms_are_on_the_floor_the_robot_reaches(world_file):
+    world = load_world(world_file(HALL))
+    floor = reachable_floor(world)
+    people = in_rooms(world, floor, 5, seed=0, keep_clear=[(world.start.x, world.start.y)])
+    assert len(people) == 5
+    points = np.array([q for p in people for q in p.path])
+    assert floor.reachable_at(points).all()
+    assert np.all(np.hypot(*(points - [world.start.x, world.start.y]).T) >= KEEP_CLEAR_M)
+
+
+def test_a_world_with_no_room_gets_fewer_people(world_file):
+    world = load_world(world_file(HALL))
+    assert on_ways(world, [np.array([[1.0, 2.0], [2.5, 2.0]])], 3, seed=0, keep_clear=[[1.0, 2.0], [2.5, 2.0]]) == []
+
+
+def test_the_copy_of_the_world_keeps_its_own_people_and_adds_the_drawn_ones(world_file, tmp_path):
+    source = world_file(HALL)
+    drawn = [Walker(((3.0, 2.0),)), Walker(((6.0, 1.0), (6.0, 3.0)), 0.8, 1.5)]
+    copy = load_world(world_with_people(str(source), tmp_path / "s0" / "hall.yaml", drawn))
+    original = load_world(source)
+    assert copy.name == "hall" and copy.walls == original.walls and copy.start == original.start
+    assert [p.path for p in copy.people] == [((9.0, 3.5),), ((3.0, 2.0),), ((6.0, 1.0), (6.0, 3.0))]
+    assert copy.people[2].speed == 0.8 and copy.people[2].wait == 1.5 and copy.people[1].radius == RADIUS
+
+
+def test_ltmap_repeats_run_with_people_on_the_route_and_the_teach_without(world_file, tmp_path):
+    path = str(world_file(HALL))
+    loaded = load_world(path)
+    settings = ltmap.check_options(path, {"people": "3"})
+    assert settings.people == 3
+    worlds, people = ltmap.repeat_worlds(path, loaded, settings, [0, 1], tmp_path)
+    assert worlds[0] == str(tmp_path / "people" / "s0000" / "world.yaml") and worlds[0] != worlds[1]
+    assert len(load_world(worlds[0]).people) == 1 + len(people[0]) and people[0] != people[1]
+    route = settings.route.world_xy
+    assert all(distance_to(route, np.asarray(p.path[0])) < 1e-9 or crosses(route, p) for p in people[0])
+    teach = ltmap.teach_episode(path, 0, settings, tmp_path, None)
+    assert teach.world == path  # taught in the world as it is
+    report = {"ground_truth": {"final_pose": {"x": 5.0, "y": 2.0, "theta": 0.0}}, "sim_time_s": 30.0}
+    repeat = ltmap.follow_episode(teach, report, ltmap.Level(0, 3, 9, 90, 1000, 1.0), 5, None, world=worlds[0])
+    assert repeat.world == worlds[0]
+    none = ltmap.check_options(path, {})
+    assert none.people == 0 and ltmap.repeat_worlds(path, loaded, none, [0], tmp_path) == ({0: path}, {})
+
+
+def test_roadmap_navigations_run_with_people_between_the_targets(world_file, tmp_path):
+    path = str(world_file(HALL.replace("people: [{path: [[9, 3.5]]}]\n", "") + """
+poses:
+  a: {x: 2.0, y: 1.0, theta_deg: 0}
+  b: {x: 8.0, y: 1.0, theta_deg: 90}
+  c: {x: 8.0, y: 3.0, theta_deg: 180}
+"""))
+    loaded = load_world(path)
+    settings = roadmap.Settings(("a", "b", "c"), 2, roadmap.NAMED, 4)
+    targets = {seed: roadmap.seed_targets(path, loaded, settings, seed, tmp_path) for seed in (0, 1)}
+    worlds, people = roadmap.navigation_worlds(loaded, settings, targets, tmp_path, None)
+    assert worlds[0] == str(tmp_path / "seeds" / "world_s0000" / "people" / "world.yaml")
+    spots = [np.array([p.x, p.y]) for p in targets[0].poses.values()]
+    ways = [np.array([a, b]) for i, a in enumerate(spots) for b in spots[i + 1:]]
+    for person in people[0]:
+        assert any(distance_to(w, np.asarray(person.path[0])) < 1e-9 or crosses(w, person) for w in ways)
+        assert all(gap(person, s) >= KEEP_CLEAR_M - 1e-9 for s in spots)
+    learn = roadmap.learn_episode(targets[0].world, 0, tmp_path, None)
+    plans = roadmap.goto_plans(learn, loaded, ["a", "b"], 2, None, run_in=worlds[0])
+    assert learn.world == path and {p.episode.world for p in plans} == {worlds[0]}
+    for plan in plans:  # nobody stands on a navigation's start
+        assert all(np.hypot(plan.start.x - q[0], plan.start.y - q[1]) >= KEEP_CLEAR_M - 1e-9
+                   for p in people[0] if len(p.path) == 1 for q in p.path)
+
+
+def test_people_zero_leaves_every_episode_as_it_was():
+    assert exploration.seed_worlds("lab", 0, [0, 1], reachable_floor(load_world("lab")), Path("/nowhere")) == (
+        {0: "lab", 1: "lab"}, {})
+    assert [e.id for e in exploration.episodes({0: "lab"}, [0])] == [e.id for e in exploration.episodes("lab", [0])]
+    teach = Episode("teach_route", "lab", 0, {"map": "m.ltmap", "camera": "landmarks"})
+    report = {"ground_truth": {"final_pose": {"x": 1.0, "y": 1.0, "theta": 0.0}}, "sim_time_s": 10.0}
+    level = ltmap.Level(0, 3, 9, 90, 1000, 1.0)
+    assert ltmap.follow_episode(teach, report, level, 5, None).id == ltmap.follow_episode(
+        teach, report, level, 5, None, world="lab").id
+
+
+def test_exploration_with_people_runs_every_variant_in_the_seeds_world(tmp_path, capsys):
+    code = main(["eval", "exploration", "--world", BOX, "--seeds", "1", "--workers", "2", "--max-time", "2",
+                 "--option", "people=2", "-o", str(tmp_path / "out"), "--json"])
+    assert code == 0, capsys.readouterr().err
+    figures = json.loads(capsys.readouterr().out)
+    assert figures["people"] == 2 and figures["people.placed"] == {"0": 2} and figures["episodes"] == 3
+    rows = [json.loads(line) for line in (tmp_path / "out" / "results.jsonl").read_text().splitlines()]
+    assert {row["world"] for row in rows} == {str(tmp_path / "out" / "people" / "s0000" / "box.yaml")}
+    assert len(load_world(rows[0]["world"]).people) == 2
+
+
+def test_a_bad_people_option_exits_2_before_any_episode(capsys):
+    assert main(["eval", "exploration", "--world", BOX, "--seeds", "1", "--option", "people=many"]) == 2
+    assert "people: an integer expected" in capsys.readouterr().err
+
+
+def test_the_tables_say_how_many_people_were_placed():
+    figures = {"people": 3, "people.placed": {"0": 3, "1": 2}}
+    assert table_line(figures) == ["people: 3 asked per seed, standing on or walking across the way (seed 0: 3, "
+                                   "seed 1: 2 placed)"]
+    assert table_line({"people": 0}) == [] and table_line({}) == []
