@@ -97,10 +97,10 @@ POSE_GOAL = (0.10, 2.0)  # m, deg: the localisation's error at the end of a run
 
 @dataclass(frozen=True)
 class Settings:
-    """The area's options, checked."""
+    """The area's options, checked: people per seed and the localisations to run."""
 
-    localisations: tuple[str, ...] = ("visual",)  # LOCALISATIONS' names, each a set of columns
     people: int = 0  # people in the rooms
+    localisations: tuple[str, ...] = ("visual",)  # LOCALISATIONS' names, each a set of columns
 
 
 def check_world(world: str) -> FloorGrid:
@@ -124,7 +124,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
         if LOCALISATIONS[name] not in cameras:
             raise ValueError(f"localisation {name} needs the camera {LOCALISATIONS[name]!r}, which world {world!r} "
                              f"does not have (cameras: {', '.join(sorted(cameras))})")
-    return Settings(names, crowd.parse_people(extra.get(crowd.OPTION)))
+    return Settings(crowd.parse_people(extra.get(crowd.OPTION)), localisations=names)
 
 
 def column(variant: str, localisation: str) -> str:

@@ -99,8 +99,9 @@ def test_three_variants_per_seed():
 
 
 def test_the_localisation_option_names_the_oracle_beside_the_visual(tmp_path):
-    assert check_options("lab", {}) == Settings(("visual",), 0)
-    assert check_options("lab", {"localisation": "visual,ideal", "people": "2"}) == Settings(("visual", "ideal"), 2)
+    assert check_options("lab", {}) == Settings(0, localisations=("visual",))
+    both = check_options("lab", {"localisation": "visual,ideal", "people": "2"})
+    assert both == Settings(2, localisations=("visual", "ideal"))
     with pytest.raises(ValueError, match="visual, ideal or visual,ideal"):
         check_options("lab", {"localisation": "gps"})
     stereo_only = tmp_path / "stereo_only.yaml"
