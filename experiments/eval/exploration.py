@@ -1,13 +1,22 @@
-"""``bearings eval exploration``: explored floor against path length and time, three ways.
+"""``bearings eval exploration``: explored floor against path length and time, four ways.
 
-Three variants of the shipped ``explore`` mission, each over the same seeds (and with each
+Four variants of the shipped ``explore`` mission, each over the same seeds (and with each
 localisation the ``localisation`` option names, see below):
 
-- ``method``: attractive power (eq. 1) with frontier mode, the cameras watching interest edges;
+- ``method``: the mission's default, attractive power (eq. 1) among the borders about as close as
+  the closest (``nearby_attraction``), frontier mode otherwise, the cameras watching interest edges;
 - ``baseline``: the closest reachable border always (classic frontier exploration), cameras fixed
   straight ahead;
 - ``fixed``: the method's goal selection with the cameras fixed straight ahead (so method vs fixed
-  measures the gaze, fixed vs baseline the goal selection).
+  measures the gaze, fixed vs baseline the goal selection);
+- ``eq1``: eq. 1 over all points, as the paper writes it, the cameras watching interest edges.
+
+Two more run when named (``--option variants=method,gaze_before,...``: the variants to run, the
+method always among them): ``gaze_before``, the method with the gaze's earlier rules (a watched
+point dropped once its bearing passes 90 degrees, ``leave: pan_limit``; the head turned back to
+straight ahead, ``turn_back: front``), so method vs gaze_before measures eq. 3 and eq. 4; and
+``closest_edges``, the closest reachable border with the cameras watching interest edges (the
+goal selection alone against the method's).
 
 The measure (ground truth, evaluation only). The reference is the world's reachable floor
 (:func:`drivers.sim.floor.reachable_floor`: where the robot's centre can go from the start). What
@@ -26,8 +35,9 @@ Figures per variant (means over seeds unless named otherwise): final ``coverage`
 ``collisions`` and ``safety_stops`` (summed over the runs), ``min_clearance_m`` (the smallest, when
 the simulator reports it), ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
 and after 60, 120 and 240 s, and the path length and time to reach 50, 80, 90 and 95 % (None when
-not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m to
-the two others'.
+not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m and
+120 s, of its path and time to 90 and 95 % and of its path length to the three others' (below 1
+for a path or a time: the method's is shorter).
 
 Localisation (option ``localisation``): ``visual`` (the default) runs the mission as shipped, its pose
 from the stereo pair's own features; ``ideal`` gives it the simulator's identified landmarks (the
@@ -74,13 +84,17 @@ from maps.exploration.head import StereoHead
 from maps.exploration.integrate import scan_cells
 from perception.geometry import Pose2D, wrap_angle
 
-DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed"
+DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed, eq. 1"
 MISSION = "explore"
 VARIANTS: dict[str, dict[str, str]] = {
-    "method": {"strategy": "attraction", "gaze": "edges"},
+    "method": {"strategy": "nearby_attraction", "gaze": "edges"},
     "baseline": {"strategy": "closest_frontier", "gaze": "fixed"},
-    "fixed": {"strategy": "attraction", "gaze": "fixed"},
+    "fixed": {"strategy": "nearby_attraction", "gaze": "fixed"},
+    "eq1": {"strategy": "attraction", "gaze": "edges"},
+    "gaze_before": {"strategy": "nearby_attraction", "gaze": "edges", "leave": "pan_limit", "turn_back": "front"},
+    "closest_edges": {"strategy": "closest_frontier", "gaze": "edges"},
 }
+DEFAULT_VARIANTS = ("method", "baseline", "fixed", "eq1")
 DISTANCES = (5.0, 10.0, 20.0, 40.0)  # m of path: coverage reached by then
 TIMES = (60.0, 120.0, 240.0)  # s
 LEVELS = (0.5, 0.8, 0.9, 0.95)  # coverage: path length and time to reach it
@@ -90,6 +104,8 @@ OPTIONS = {
     "localisation": "how the robot localises: visual (the stereo pair's own features; default), ideal (the "
                     "simulator's identified landmarks, an oracle), or visual,ideal (both, side by side)",
     crowd.OPTION: crowd.HELP + " (in the rooms)",
+    "variants": f"the variants to run, comma-separated ({', '.join(VARIANTS)}; default "
+                f"{','.join(DEFAULT_VARIANTS)}; the method always runs)",
 }
 LOCALISATIONS = {"visual": "stereo", "ideal": "landmarks"}  # -> the mission's localisation input (a camera)
 POSE_GOAL = (0.10, 2.0)  # m, deg: the localisation's error at the end of a run
@@ -97,9 +113,11 @@ POSE_GOAL = (0.10, 2.0)  # m, deg: the localisation's error at the end of a run
 
 @dataclass(frozen=True)
 class Settings:
-    """The area's options, checked: people per seed and the localisations to run."""
+    """The area's options, checked: people per seed, the variants to run (the method first) and the
+    localisations to run each with."""
 
     people: int = 0  # people in the rooms
+    variants: tuple[str, ...] = DEFAULT_VARIANTS
     localisations: tuple[str, ...] = ("visual",)  # LOCALISATIONS' names, each a set of columns
 
 
@@ -113,8 +131,15 @@ def check_world(world: str) -> FloorGrid:
 
 
 def check_options(world: str, extra: Mapping[str, str]) -> Settings:
-    """The options (``OPTIONS``) checked: the localisations (against the world's cameras) and the number
-    of people; ``ValueError`` with the problem."""
+    """The options (``OPTIONS``) checked: the variants, the localisations (against the world's cameras)
+    and the number of people; ``ValueError`` with the problem."""
+    text = extra.get("variants")
+    named = [n.strip() for n in text.split(",") if n.strip()] if text is not None else list(DEFAULT_VARIANTS)
+    unknown = [n for n in named if n not in VARIANTS]
+    if unknown or not named:
+        raise ValueError(f"variants={text!r}: {', '.join(unknown) or 'none named'} "
+                         f"(known: {', '.join(VARIANTS)})")
+    variants = ("method", *dict.fromkeys(n for n in named if n != "method"))
     names = tuple(dict.fromkeys(n.strip() for n in extra.get("localisation", "visual").split(",")))
     unknown = [n for n in names if n not in LOCALISATIONS]
     if unknown or not names:
@@ -124,7 +149,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
         if LOCALISATIONS[name] not in cameras:
             raise ValueError(f"localisation {name} needs the camera {LOCALISATIONS[name]!r}, which world {world!r} "
                              f"does not have (cameras: {', '.join(sorted(cameras))})")
-    return Settings(crowd.parse_people(extra.get(crowd.OPTION)), localisations=names)
+    return Settings(crowd.parse_people(extra.get(crowd.OPTION)), variants=variants, localisations=names)
 
 
 def column(variant: str, localisation: str) -> str:
@@ -133,12 +158,12 @@ def column(variant: str, localisation: str) -> str:
 
 
 def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: float | None = None,
-             localisations: Sequence[str] = ("visual",)) -> list[Episode]:
-    """The evaluation's runs: every variant on every seed (in ``world``, or per seed ``world[seed]``),
+             variants: Sequence[str] = DEFAULT_VARIANTS, localisations: Sequence[str] = ("visual",)) -> list[Episode]:
+    """The evaluation's runs: every variant named on every seed (in ``world``, or per seed ``world[seed]``),
     with every localisation."""
     where = world if isinstance(world, Mapping) else dict.fromkeys(seeds, world)
-    return [Episode(MISSION, where[seed], seed, {**inputs, "localisation": LOCALISATIONS[loc]}, max_time_s)
-            for loc in localisations for inputs in VARIANTS.values() for seed in seeds]
+    return [Episode(MISSION, where[seed], seed, {**VARIANTS[name], "localisation": LOCALISATIONS[loc]}, max_time_s)
+            for loc in localisations for name in variants for seed in seeds]
 
 
 def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
@@ -156,11 +181,13 @@ def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
 
 
 def variant_of(inputs: dict[str, Any]) -> str:
-    """The column of an episode's inputs (:func:`column`)."""
+    """The column (:func:`column`) of the variant whose inputs are exactly ``inputs`` besides the
+    localisation."""
+    given = {k: str(v) for k, v in inputs.items() if v is not None and k != "localisation"}
     camera = str(inputs.get("localisation", LOCALISATIONS["visual"]))
     localisation = next((k for k, v in LOCALISATIONS.items() if v == camera), None)
     for name, values in VARIANTS.items():
-        if localisation is not None and all(str(inputs.get(k)) == v for k, v in values.items()):
+        if localisation is not None and given == values:
             return column(name, localisation)
     raise KeyError(f"no variant has the inputs {inputs}")
 
@@ -357,11 +384,11 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     localisations, count = settings.localisations, settings.people
     world = load_world(options.world)
     where, people = seed_worlds(options.world, count, options.seeds, floor, Path(options.results_dir).resolve())
-    todo = episodes(where, options.seeds, options.max_time_s, localisations)
+    todo = episodes(where, options.seeds, options.max_time_s, settings.variants, localisations)
     rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,
                      progress=options.progress, resume=resume)
     by_variant: dict[str, list[dict[str, Any]]] = {column(name, loc): [] for loc in localisations
-                                                   for name in VARIANTS}
+                                                   for name in settings.variants}
     runs = []
     for row in rows:
         report = read_report(options.results_dir, row["id"])
@@ -380,14 +407,15 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     for name, figures in summary.items():
         out.update({f"{name}.{key}": value for key, value in figures.items()})
     for loc in localisations:
-        method = summary[column("method", loc)]
-        for other in ("fixed", "baseline"):
+        method = summary.get(column("method", loc), {})
+        for other in [n for n in settings.variants if n != "method" and column(n, loc) in summary]:
             versus, theirs = f"{column('method', loc)}_vs_{column(other, loc)}", summary[column(other, loc)]
-            for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s"):
+            for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s", "path_to_90pct_m",
+                        "path_to_95pct_m", "time_to_90pct_s", "time_to_95pct_s"):
                 out[f"{versus}.{key}_ratio"] = _ratio(method.get(key), theirs.get(key))
             out[f"{versus}.path_length_ratio"] = _ratio(method.get("path_length_m"), theirs.get("path_length_m"))
     if {"visual", "ideal"} <= set(localisations):  # what the oracle was worth
-        for name in VARIANTS:
+        for name in [n for n in settings.variants if n in summary and column(n, "ideal") in summary]:
             visual, ideal = summary[name], summary[column(name, "ideal")]
             for key in ("map_on_obstacles_m2", "path_length_m"):
                 out[f"{name}_visual_vs_ideal.{key.rsplit('_', 1)[0]}_ratio"] = _ratio(visual.get(key), ideal.get(key))
