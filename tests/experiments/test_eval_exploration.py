@@ -11,10 +11,12 @@ import pytest
 
 from drivers.sim.world import load_world
 from experiments.eval.exploration import (
+    Settings,
     check_options,
     check_world,
     episode_figures,
     episodes,
+    pose_errors,
     seen_floor,
     summarise_variant,
     variant_of,
@@ -94,6 +96,37 @@ def test_four_variants_per_seed():
     assert len(runs) == 8 and {e.inputs["gaze"] for e in runs} == {"edges", "fixed"}
     assert {e.inputs["strategy"] for e in runs} == {"nearby_attraction", "attraction", "closest_frontier"}
     assert {variant_of(e.inputs) for e in runs} == {"method", "baseline", "fixed", "eq1"}
+    assert {e.inputs["localisation"] for e in runs} == {"stereo"}  # the visual localisation by default
+
+
+def test_the_localisation_option_names_the_oracle_beside_the_visual(tmp_path):
+    assert check_options("lab", {}) == Settings(0, localisations=("visual",))
+    both = check_options("lab", {"localisation": "visual,ideal", "people": "2"})
+    assert both == Settings(2, localisations=("visual", "ideal"))
+    with pytest.raises(ValueError, match="visual, ideal or visual,ideal"):
+        check_options("lab", {"localisation": "gps"})
+    stereo_only = tmp_path / "stereo_only.yaml"
+    stereo_only.write_text(Path(BOX).read_text() + "cameras:\n  - {name: stereo, kind: stereo, mount: ptu}\n")
+    assert check_options(str(stereo_only), {"localisation": "visual"}).localisations == ("visual",)
+    with pytest.raises(ValueError, match="localisation ideal needs the camera 'landmarks'"):
+        check_options(str(stereo_only), {"localisation": "visual,ideal"})
+    runs = episodes("lab", [0], variants=("method", "baseline", "fixed"), localisations=("visual", "ideal"))
+    assert len(runs) == 6 and sorted(variant_of(e.inputs) for e in runs) == [
+        "baseline", "baseline/ideal", "fixed", "fixed/ideal", "method", "method/ideal"]
+
+
+def test_the_pose_error_is_against_the_truth_in_the_start_frame():
+    # the robot starts at (1, 2) facing +y; the odometry frame's x axis is the world's +y
+    trajectory = [[0.0, 1.0, 2.0, math.pi / 2], [10.0, 1.0, 4.0, math.pi / 2]]
+    located = {"final_pose": {"x": 2.05, "y": 0.0, "theta": math.radians(1.0), "t": 10.0},
+               "track": [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0], [5.0, 1.0, 0.03, 0.0, 0.01, 0.001]],
+               "position_sigma_m": 0.02}
+    errors = pose_errors(report([], trajectory, localisation=located))
+    # the final pose is (2.05, 0) in the start frame: world (1, 4.05), 5 cm beyond the truth, 1 degree off
+    assert errors["pose_error_m"] == pytest.approx(0.05) and errors["heading_error_deg"] == pytest.approx(1.0)
+    assert errors["pose_error_max_m"] == pytest.approx(0.05) and errors["pose_ok"]
+    assert errors["pose_error_at_60s_m"] == pytest.approx(0.03)  # the last row by then: (1, 0.03) at 5 s
+    assert pose_errors(report([], trajectory)) == {}
 
 
 def test_the_variants_option_names_the_runs_and_the_method_always_runs():
@@ -103,6 +136,7 @@ def test_the_variants_option_names_the_runs_and_the_method_always_runs():
     # the method and gaze_before differ only in the two gaze rules; each run maps back to its own variant
     assert [variant_of(e.inputs) for e in runs] == ["method", "gaze_before", "closest_edges"]
     assert runs[1].inputs == {**runs[0].inputs, "leave": "pan_limit", "turn_back": "front"}
+    assert all(e.inputs["localisation"] == "stereo" for e in runs)
     assert check_options("lab", {}).variants == ("method", "baseline", "fixed", "eq1")
     with pytest.raises(ValueError, match="nearest"):
         check_options("lab", {"variants": "method,nearest"})
