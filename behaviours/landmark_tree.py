@@ -22,13 +22,13 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.ports import READS, WRITES, InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.telemetry import Figure, section
 from maps.ltmap.file import load_ltmap, save_ltmap
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
 from maps.ltmap.tree import LandmarkTree, MapSummary
-from maps.store import InputError
+from maps.store import InputError, check_not_redirected
 
 LTMAP_KEY = "/map/ltmap"
 LTMAP_IN = InputPort("ltmap", LandmarkTree, Ref(LTMAP_KEY), doc="the LT-map of the taught route")
@@ -50,7 +50,10 @@ def summary_section(summary: MapSummary) -> dict[str, Any]:
 
 
 def save_map(path: str, tree: LandmarkTree) -> None:
-    """Save atomically (a failed save keeps the previous file): the one way the nodes write maps."""
+    """Save atomically (a failed save keeps the previous file): the one way the nodes write maps.
+    Never through a symbolic link put in the way since the mission was loaded (its path was checked
+    to lie in the output folder then)."""
+    check_not_redirected(path)
     save_ltmap(path, tree)
 
 
@@ -62,7 +65,8 @@ class LoadMap(BearingsBehaviour):
     the file is checked whole (version, checksum, tree consistency) before anything follows it.
     """
 
-    PATH = InputPort("path", str, doc="the LT-map file (a mission input: --set map=route.ltmap)", literal_only=True)
+    PATH = InputPort("path", str, doc="the LT-map file (a mission input: --set map=route.ltmap)", literal_only=True,
+                     file=READS)
     PORTS = (PATH, LTMAP_OUT)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
@@ -105,7 +109,8 @@ class PruneMap(BearingsBehaviour):
                          doc="memory budget as a fraction of the map's size; 1: none")
     MIN_LANDMARKS = InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0,
                               doc="viewframes left with fewer landmarks are deleted (the paper: 50, enough for homing)")
-    PATH = InputPort("path", str, "", literal_only=True, doc="save the pruned map here too (empty: do not save)")
+    PATH = InputPort("path", str, "", literal_only=True, file=WRITES,
+                     doc="save the pruned map here too (empty: do not save)")
     SOURCE = InputPort("source", LandmarkTree, Ref(LTMAP_KEY), doc="the LT-map to prune")
     PORTS = (BUDGET, FRACTION, MIN_LANDMARKS, PATH, SOURCE, LTMAP_OUT)
 

@@ -5,7 +5,9 @@ As in BehaviorTree.CPP, every node type declares its ports, here with Python typ
 - an :class:`InputPort` takes a literal (checked against the port's type, unit and range at load
   time) or a reference ``{/ns/key}`` to a blackboard entry read when the node ticks; its default
   may itself be a reference (``Drive`` reads ``{/robot/odometry}`` unless a mission says
-  otherwise);
+  otherwise); a port whose text names a file declares it (``file=READS`` or ``file=WRITES``), so
+  the loader resolves every such path the same way and keeps the files a mission writes inside
+  its output folders (:class:`maps.store.OutputFolders`), plugins' ports included;
 - an :class:`OutputPort` names the blackboard key the node writes; a mission may remap it per
   node (two ``Perceive`` nodes on two cameras write two observation keys).
 
@@ -33,6 +35,8 @@ REF_PATTERN = re.compile(r"^\{(/[A-Za-z_][\w/]*(?:\.[A-Za-z_]\w*)*)\}$")
 KEY_PATTERN = re.compile(r"^/[A-Za-z_][\w/]*(?:\.[A-Za-z_]\w*)*$")
 NAMESPACES = ("/robot", "/ptu", "/perception", "/map", "/mission")
 COMPARISONS = ("==", "!=", "<", "<=", ">", ">=")
+READS, WRITES = "reads", "writes"
+"""``InputPort.file``: the port's text names a file (or folder) the node reads, or a file it writes."""
 
 # The types a mission can name (input declarations, ``bearings schema``), by their YAML names.
 TYPE_NAMES: dict[str, Any] = {
@@ -75,7 +79,10 @@ class InputPort(Generic[T]):
 
     ``unit`` is the unit a mission writes the value in; ``choices`` restrict a ``str``;
     ``minimum``/``maximum`` bound numbers; ``literal_only`` ports configure the node and cannot
-    change while it runs (they take no reference).
+    change while it runs (they take no reference). ``file`` is :data:`READS` or :data:`WRITES`
+    when the text names a file: relative paths are resolved against the mission's output folder
+    before the node is built, and a written file must lie inside the output folders (checked at
+    load; such a port is ``str`` and ``literal_only``, see :func:`file_port_problem`).
 
     The port is generic in its value type, so ``node.get_input(SPEED)`` is a ``float`` to mypy
     (``InputPort("speed", float, ...)`` infers ``InputPort[float]``). A union type cannot be
@@ -91,6 +98,7 @@ class InputPort(Generic[T]):
     minimum: float | None = None
     maximum: float | None = None
     literal_only: bool = False
+    file: str = ""
 
     @property
     def required(self) -> bool:
@@ -121,6 +129,18 @@ class OutputPort(Generic[T]):
 
 
 Port = InputPort[Any] | OutputPort[Any]
+
+
+def file_port_problem(port: InputPort) -> str | None:
+    """Why a port declared to name a file is malformed, or None: a written file must be known at
+    load time (a literal), so that where it goes is checked before anything runs."""
+    if port.file not in ("", READS, WRITES):
+        return f"port {port.name!r}: file is {READS!r}, {WRITES!r} or empty, not {port.file!r}"
+    if port.file and port.type is not str:
+        return f"port {port.name!r} names a file: its type is str"
+    if port.file == WRITES and not port.literal_only:
+        return f"port {port.name!r} names a file it writes: it must be literal_only (checked at load)"
+    return None
 
 
 # -- type names and compatibility ------------------------------------------------------------------

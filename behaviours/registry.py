@@ -31,7 +31,7 @@ from typing import Any, ClassVar, Literal
 
 import py_trees
 
-from behaviours.ports import InputPort, OutputPort, Port
+from behaviours.ports import InputPort, OutputPort, Port, file_port_problem
 
 Kind = Literal["action", "condition", "decorator", "composite"]
 KINDS: tuple[Kind, ...] = ("action", "condition", "decorator", "composite")
@@ -139,6 +139,8 @@ def _declaration_problems(name: str, kind: Any, ports: tuple[Any, ...], low: Any
         problems.append("PORTS holds InputPort and OutputPort values only")
     elif len(set(names)) != len(names) or {"name", "child", "children"} & set(names):
         problems.append("port names must be unique and not 'name', 'child' or 'children'")
+    else:
+        problems += [p for p in (file_port_problem(port) for port in ports if isinstance(port, InputPort)) if p]
     leaf = kind in ("action", "condition")
     if not (isinstance(low, int) and (high is None or isinstance(high, int))) or (leaf and (low, high) != (0, 0)):
         problems.append("CHILDREN is (fewest, most); leaves take (0, 0)")

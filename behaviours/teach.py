@@ -26,7 +26,7 @@ from py_trees.common import Status
 from behaviours.base import BearingsDecorator
 from behaviours.landmark_tree import LTMAP_OUT, save_map, summary_section
 from behaviours.motion import ODOMETRY
-from behaviours.ports import InputPort, Ref
+from behaviours.ports import WRITES, InputPort, Ref
 from behaviours.registry import register
 from behaviours.telemetry import Drawing, Figure, Points, section
 from maps.ltmap.learner import LearnConfig, LearnStep, RouteLearner
@@ -45,7 +45,8 @@ class LearnRoute(BearingsDecorator):
     child fails (nothing saved), when nothing was observed, or when the file cannot be written.
     """
 
-    PATH = InputPort("path", str, "", literal_only=True, doc="the LT-map file written at the end; empty: not saved")
+    PATH = InputPort("path", str, "", literal_only=True, file=WRITES,
+                     doc="the LT-map file written at the end; empty: not saved")
     THRESHOLD = InputPort("threshold", float, DEFAULT_THRESHOLD, unit="rad^2", minimum=1e-9, literal_only=True,
                           doc="eq. 1: a new viewframe when delta_t passes it")
     BUDGET = InputPort("budget", int, 0, unit="B", minimum=0, literal_only=True,

@@ -66,6 +66,13 @@ class ArcosPort:
         self._pending = []
         self.baud = baud if self.is_device else None
 
+    def fileno(self) -> int | None:
+        """The open port's file descriptor (for the link guard), None when it has none."""
+        try:
+            return int(self._serial.fileno())
+        except (AttributeError, OSError, ValueError, TypeError, serial.SerialException):
+            return None
+
     def send(self, data: bytes) -> None:
         with self._lock:
             if self._serial is None:

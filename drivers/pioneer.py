@@ -36,6 +36,9 @@ Sensing: ``range_source()`` is the robot's :class:`~drivers.interfaces.RangeSour
 collision monitor: the sonar ring with the geometry of the model the robot reports and the
 bumpers (:mod:`drivers.pioneer_body`, from ARIA's parameter files); a transducer not heard for
 ``sonar_timeout`` reads as no data.
+- the process dies without closing the base (``kill -9``, a crash, a plugin's ``os._exit``):
+  with ``guard`` (the default) a guard process holding a copy of the link stops the robot and
+  CLOSEs the session at once (:mod:`drivers.link_guard`); the firmware watchdog is the last net.
 
 The odometry frame starts at the pose of the first SIP (0, 0, 0) and stays continuous across
 the robot's 15-bit position wrap-around and across reconnections. The measured turn rate is the
@@ -61,6 +64,7 @@ from drivers import arcos
 from drivers.arcos import Command, Identity, ModelParams, Odometry, RobotConfig, Sip
 from drivers.arcos_port import ArcosPort
 from drivers.common import DriverFault, Stamp, build_settings, monotonic_stamp
+from drivers.link_guard import LinkGuard
 from drivers.pioneer_body import BODIES, PioneerBody, PioneerRanges
 from drivers.pioneer_settings import ModelChoice, PioneerSettings, choose_model
 from perception.geometry import Pose2D, wrap_angle
@@ -140,6 +144,7 @@ class PioneerBase:
         self._last_drive = time.monotonic()
         self._last_sip = time.monotonic()
         self._closed = False
+        self._guard: LinkGuard | None = None
 
     # -- the Base interface ----------------------------------------------------------------------
     def drive(self, v: float, w: float) -> None:
@@ -298,6 +303,15 @@ class PioneerBase:
         self._send(arcos.encode_command(Command.ENABLE, 1))
         self._send_velocity()
         self._await_first_sip(deadline)
+        self._start_guard()
+
+    def _start_guard(self) -> None:
+        """A process that stops the robot if this one dies with the session open (drivers/link_guard.py)."""
+        fd = self._link.fileno() if self.settings.guard else None
+        if fd is not None:
+            farewell = (arcos.encode_command(Command.STOP) + arcos.encode_vel(0) + arcos.encode_rvel(0)
+                        + arcos.encode_command(Command.ENABLE, 0) + arcos.encode_command(Command.CLOSE))
+            self._guard = LinkGuard.start(fd, farewell)
 
     def _open_port(self) -> None:
         self._link.open(self.settings.baud)
@@ -539,6 +553,9 @@ class PioneerBase:
         time.sleep(seconds)
 
     def _release_port(self) -> None:
+        guard, self._guard = self._guard, None
+        if guard is not None:
+            guard.release()
         self._link.release()
         if self._odometry is not None:
             self._odometry.restart()

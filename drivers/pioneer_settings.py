@@ -63,6 +63,10 @@ class PioneerSettings(BaseModel):
     sonar_timeout: float = quantity(1.0, "a transducer not heard for this long reads as no data (nan) for the "
                                     "collision monitor (the ring fires in turn: about 0.5 s for all 16)", "s",
                                     ge=0.1, le=10.0)
+    guard: bool = Field(True, description="while a session is open, a guard process holds the link and stops "
+                        "the robot (STOP, ENABLE 0, CLOSE) if this process dies without closing it (a crash, "
+                        "kill -9, a plugin's os._exit): within milliseconds instead of the firmware watchdog's "
+                        "seconds (drivers/link_guard.py)")
     request_config: bool = Field(True, description="ask for the config packet when connecting (limits, "
                                  "firmware watchdog, serial number, whether HOSTBAUD is allowed; shown by "
                                  "'bearings doctor')")

@@ -21,20 +21,22 @@ from __future__ import annotations
 
 import io
 import json
+import math
 import os
 import zipfile
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from maps.store import Diagnostic, InputError, checksum, read_bytes, write_bytes_atomic
+from maps.store import Diagnostic, InputError, checksum, open_regular, read_limited, write_bytes_atomic
 
 MAGIC = b"BEARINGS-MAP\n"
 MAX_HEADER_BYTES = 1 << 20  # a header is a few hundred bytes; a longer "line" is not a map file
 MAX_MAP_BYTES = 1 << 31  # 2 GiB: far above any map's memory budget
+MAX_ARRAYS = 64  # named arrays in one map file (an LT-map has 5, a roadmap a few more)
 
 
 class MapHeader(BaseModel):
@@ -82,11 +84,62 @@ def write_map_file(path: str | os.PathLike, *, kind: str, version: int, arrays: 
     write_bytes_atomic(path, encode_map(kind=kind, version=version, arrays=arrays, meta=meta))
 
 
+def _bad(file: str, message: str) -> InputError:
+    return InputError([Diagnostic(file, 0, 0, message)])
+
+
 def decode_map(data: bytes, *, file: str, kind: str | None = None, versions: Iterable[int] | None = None) -> MapFile:
     """Check and decode map-file bytes; :class:`InputError` (one line) when they are not a valid map."""
+    header, end = _decode_header(data, file=file, kind=kind, versions=versions)
+    payload = data[end + 1:]
+    if len(payload) != header.payload_bytes:
+        what = "truncated" if len(payload) < header.payload_bytes else "has trailing bytes"
+        raise _bad(file, f"damaged map file: {what} ({len(payload)} of {header.payload_bytes} payload bytes)")
+    if checksum(payload) != header.sha256:
+        raise _bad(file, "damaged map file: the checksum does not match its content")
+    try:
+        _check_members(payload, file)
+        with np.load(io.BytesIO(payload), allow_pickle=False) as npz:
+            arrays = {name: npz[name] for name in npz.files}
+    except (ValueError, OSError, zipfile.BadZipFile) as exc:
+        raise _bad(file, f"damaged map file: unreadable arrays ({exc})") from None
+    return MapFile(header, arrays)
+
+
+_ARRAY_HEADERS = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
+
+
+def _check_members(payload: bytes, file: str) -> None:
+    """Refuse, before numpy allocates anything, a payload whose arrays are not what they declare:
+    a compressed member (bearings stores them plain, so nothing inflates past the file's own
+    length), or an array header whose shape needs more bytes than the member holds (a (10^12,)
+    array in a few bytes)."""
+    with zipfile.ZipFile(io.BytesIO(payload)) as archive:
+        members = archive.infolist()
+        if len(members) > MAX_ARRAYS:
+            raise _bad(file, f"damaged map file: {len(members)} arrays (a map has at most {MAX_ARRAYS})")
+        for member in members:
+            if member.compress_type != zipfile.ZIP_STORED or member.file_size != member.compress_size:
+                raise _bad(file, f"damaged map file: array {member.filename!r} is compressed (map arrays are stored "
+                                 "plain)")
+            with archive.open(member) as stream:
+                version = np.lib.format.read_magic(stream)
+                read_header = _ARRAY_HEADERS.get(version)
+                if read_header is None:
+                    raise _bad(file, f"damaged map file: array {member.filename!r} has .npy format {version}")
+                shape, _fortran, dtype = read_header(stream)
+                needed = math.prod(shape) * dtype.itemsize
+                if needed != member.file_size - stream.tell():
+                    raise _bad(file, f"damaged map file: array {member.filename!r} declares {shape} {dtype} "
+                                     f"({needed} bytes) in a member of {member.file_size} bytes")
+
+
+def _decode_header(data: bytes, *, file: str, kind: str | None, versions: Iterable[int] | None
+                   ) -> tuple[MapHeader, int]:
+    """The checked header of map-file bytes and where its line ends."""
 
     def bad(message: str) -> InputError:
-        return InputError([Diagnostic(file, 0, 0, message)])
+        return _bad(file, message)
 
     if not data.startswith(MAGIC):
         raise bad("not a bearings map file (it does not start with BEARINGS-MAP)")
@@ -105,22 +158,28 @@ def decode_map(data: bytes, *, file: str, kind: str | None = None, versions: Ite
         hint = "written by a newer bearings" if header.version > newest else "an old format no longer read"
         raise bad(f"{header.kind} map format version {header.version} is not supported ({hint}; this version "
                   f"reads {', '.join(map(str, allowed))})")
-    payload = data[end + 1:]
-    if len(payload) != header.payload_bytes:
-        what = "truncated" if len(payload) < header.payload_bytes else "has trailing bytes"
-        raise bad(f"damaged map file: {what} ({len(payload)} of {header.payload_bytes} payload bytes)")
-    if checksum(payload) != header.sha256:
-        raise bad("damaged map file: the checksum does not match its content")
-    try:
-        with np.load(io.BytesIO(payload), allow_pickle=False) as npz:
-            arrays = {name: npz[name] for name in npz.files}
-    except (ValueError, OSError, zipfile.BadZipFile) as exc:
-        raise bad(f"damaged map file: unreadable arrays ({exc})") from None
-    return MapFile(header, arrays)
+    return header, end
 
 
 def read_map_file(path: str | os.PathLike, *, kind: str | None = None, versions: Iterable[int] | None = None
                   ) -> MapFile:
-    """Load a map file, checking magic, kind, version, length and checksum before decoding."""
-    data = read_bytes(path, limit=len(MAGIC) + MAX_HEADER_BYTES + MAX_MAP_BYTES, what="a map file")
-    return decode_map(data, file=str(path), kind=kind, versions=versions)
+    """Load a map file, checking magic, kind, version, length and checksum before decoding. Reads
+    the magic line and header first and then only the payload the header declares (and one byte
+    more, to tell trailing bytes): ``/dev/zero`` or a foreign file costs a few bytes, not 2 GiB."""
+    name = str(path)
+    with open_regular(path) as handle:
+        head = handle.read(len(MAGIC))
+        if head != MAGIC:
+            raise _bad(name, "not a bearings map file (it does not start with BEARINGS-MAP)")
+        head += _read_line(handle, MAX_HEADER_BYTES, name)
+        header, end = _decode_header(head, file=name, kind=kind, versions=versions)
+        payload = read_limited(handle, header.payload_bytes, name)
+    return decode_map(head + payload, file=name, kind=kind, versions=versions)
+
+
+def _read_line(handle: BinaryIO, limit: int, name: str) -> bytes:
+    """Bytes up to and including the next newline, at most ``limit`` of them (then: what was read)."""
+    try:
+        return handle.readline(limit)
+    except OSError as exc:
+        raise _bad(name, f"cannot read: {exc.strerror}") from None

@@ -13,13 +13,15 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import re
+import stat
 import tempfile
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import yaml
 
@@ -157,8 +159,10 @@ def _construct(node: yaml.Node, loader: _SafeLoader, file: str, budget: _Budget)
     try:
         return loader.construct_object(node, deep=True)
     except (ValueError, TypeError, OverflowError) as exc:  # an explicit tag on a value it cannot hold
-        raise InputError([Diagnostic(file, *_pos(node), f"malformed YAML: {node.value!r} cannot be read as "
-                                     f"{node.tag.rsplit(':', 1)[-1]} ({type(exc).__name__})")]) from None
+        text = node.value if len(node.value) <= 40 else f"{node.value[:20]}...{node.value[-8:]}"
+        length = "" if text is node.value else f", {len(node.value)} characters"
+        raise InputError([Diagnostic(file, *_pos(node), f"malformed YAML: {text!r} cannot be read as "
+                                     f"{node.tag.rsplit(':', 1)[-1]} ({type(exc).__name__}{length})")]) from None
 
 
 def _pos(node: yaml.Node) -> tuple[int, int]:
@@ -193,23 +197,45 @@ def parse_yaml(text: str, *, file: str = "<string>") -> Any:
             loader.dispose()
 
 
-def read_bytes(path: str | os.PathLike, *, limit: int, what: str) -> bytes:
-    """The bytes of a file named by the user, at most ``limit`` of them (``/dev/zero`` or a 300 MB
-    line must not fill memory); a clear :class:`InputError` on any failure. ``what`` names the
-    kind of file in the too-large message."""
+def open_regular(path: str | os.PathLike) -> BinaryIO:
+    """A regular file named by the user, open for reading; :class:`InputError` in one line for
+    anything else. Opened without blocking and checked before a byte is read: a FIFO would block
+    until someone writes to it, ``/dev/zero`` never ends, a directory is not a file."""
     name = str(path)
     try:
-        with open(path, "rb") as handle:
-            data = handle.read(limit + 1)
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     except FileNotFoundError:
         raise InputError([Diagnostic(name, 0, 0, "no such file")]) from None
     except IsADirectoryError:
         raise InputError([Diagnostic(name, 0, 0, "is a directory, not a file")]) from None
     except OSError as exc:
         raise InputError([Diagnostic(name, 0, 0, f"cannot read: {exc.strerror}")]) from None
+    mode = os.fstat(fd).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        what = "a directory" if stat.S_ISDIR(mode) else "a pipe" if stat.S_ISFIFO(mode) else "a device or socket"
+        raise InputError([Diagnostic(name, 0, 0, f"is {what}, not a regular file")])
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, "rb")
+
+
+def read_bytes(path: str | os.PathLike, *, limit: int, what: str) -> bytes:
+    """The bytes of a regular file named by the user (:func:`open_regular`), at most ``limit`` of
+    them (a 300 MB line must not fill memory); a clear :class:`InputError` on any failure.
+    ``what`` names the kind of file in the too-large message."""
+    with open_regular(path) as handle:
+        data = read_limited(handle, limit, str(path))
     if len(data) > limit:
-        raise InputError([Diagnostic(name, 0, 0, f"larger than {limit // (1024 * 1024)} MB: not {what}")])
+        raise InputError([Diagnostic(str(path), 0, 0, f"larger than {limit // (1024 * 1024)} MB: not {what}")])
     return data
+
+
+def read_limited(handle: BinaryIO, limit: int, name: str) -> bytes:
+    """Up to ``limit + 1`` bytes from ``handle`` (one more than allowed tells a file too large)."""
+    try:
+        return handle.read(limit + 1)
+    except OSError as exc:
+        raise InputError([Diagnostic(name, 0, 0, f"cannot read: {exc.strerror}")]) from None
 
 
 def read_text(path: str | os.PathLike) -> str:
@@ -249,6 +275,48 @@ def output_problem(path: str | os.PathLike) -> str | None:
     if target.exists() and not os.access(target, os.W_OK):
         return "is not writable"
     return None
+
+
+@dataclass(frozen=True, slots=True)
+class OutputFolders:
+    """Where a mission's files go: relative paths resolve against ``base``, and a file the mission
+    writes must lie inside one of ``roots`` (its own folder, the ``--output-dir``) once every
+    symbolic link on the way is followed, so neither ``/any/where`` nor ``..`` nor a link inside
+    the folder that points out can make it write elsewhere. Both are absolute, links resolved."""
+
+    base: Path
+    roots: tuple[Path, ...]
+
+    @classmethod
+    def of(cls, base: str | os.PathLike, *roots: str | os.PathLike) -> OutputFolders:
+        real = Path(os.path.realpath(base))
+        return cls(real, tuple(dict.fromkeys([real, *(Path(os.path.realpath(r)) for r in roots)])))
+
+    def resolve(self, text: str) -> Path:
+        """The file a port's text names: absolute, every existing symbolic link followed."""
+        return Path(os.path.realpath(self.base / os.fspath(text)))
+
+    def outside(self, text: str) -> str | None:
+        """Why a file the mission would write at ``text`` is refused (outside every root), or None."""
+        target = self.resolve(text)
+        if any(target == root or root in target.parents for root in self.roots):
+            return None
+        where = " or ".join(str(root) for root in self.roots)
+        via = f" (through a symbolic link: {target})" if target != Path(os.path.abspath(self.base / text)) else ""
+        return f"{text!r} is outside the mission's output folder {where}{via}: give --output-dir to write elsewhere"
+
+
+def check_not_redirected(path: str | os.PathLike) -> None:
+    """``OSError`` when a file a mission writes is now reached through a symbolic link: the loader
+    gave the node an absolute path with every link resolved (:class:`OutputFolders`), so a link
+    there now (or in an absolute path's folders) was put in its way since and must not take the
+    write out of the output folder."""
+    text = os.fspath(path)
+    folder = os.path.dirname(text)
+    moved = os.path.isabs(text) and os.path.realpath(folder) != os.path.normpath(folder)
+    if os.path.islink(text) or moved:
+        raise OSError(f"{text} is reached through a symbolic link (to {os.path.realpath(text)}); a mission's "
+                      "file is not written through one")
 
 
 def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
@@ -314,9 +382,26 @@ def write_yaml(path: str | os.PathLike, data: Any, *, header: str = "") -> None:
     write_text_atomic(path, comment + body)
 
 
+def finite(data: Any) -> Any:
+    """``data`` with every non-finite float (inf, nan) replaced by None, in mappings and lists."""
+    if isinstance(data, float):
+        return data if math.isfinite(data) else None
+    if isinstance(data, dict):
+        return {key: finite(value) for key, value in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [finite(value) for value in data]
+    return data
+
+
+def json_text(data: Any, **options: Any) -> str:
+    """Strict JSON (RFC 8259: no ``Infinity`` or ``NaN``, which other readers refuse): non-finite
+    numbers become ``null``, as the docs promise for every JSON file and line bearings writes."""
+    return json.dumps(finite(data), allow_nan=False, **options)
+
+
 def write_json(path: str | os.PathLike, data: Any) -> None:
-    """Atomically write JSON (reports), indented for people."""
-    write_text_atomic(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
+    """Atomically write strict JSON (reports, summaries), indented for people."""
+    write_text_atomic(path, json_text(data, indent=2, sort_keys=False) + "\n")
 
 
 def checksum(payload: bytes) -> str:

@@ -116,7 +116,7 @@ def reads_as_double(value: float) -> bool:
     return math.isfinite(value) and (value == 0.0 or abs(value) >= sys.float_info.min)
 
 
-_INT = re.compile(r"[+-]?\d+")
+_INT = re.compile(r"[+-]?\d{1,100}")  # longer is no quantity (and int() refuses past 4300 digits): text
 _FLOAT = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
 TRUE_TEXT, _FALSE = ("true", "True", "TRUE", "1"), ("false", "False", "FALSE", "0")  # BT.CPP's booleans
 

@@ -12,10 +12,14 @@ command only: one line on stderr names it and the others work.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import importlib
+import os
 import sys
+import threading
 from importlib.metadata import EntryPoint, entry_points
+from typing import NoReturn
 
 from missions.commands import COMMANDS, ENTRY_POINT_GROUP
 
@@ -79,7 +83,34 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except BrokenPipeError:  # e.g. `bearings schema | head`
         return 0
+    except OSError as exc:  # the machine refused (a full disk, a vanished folder): one line, never a traceback
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"bearings {args.command}: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 1
+
+
+def console(argv: list[str] | None = None) -> NoReturn:
+    """The ``bearings`` program: :func:`main`, then the end of the process with its exit code."""
+    end_process(main(argv))
+
+
+def end_process(code: int) -> NoReturn:
+    """Exit with ``code`` once the command is done (its report written, its summary printed), even
+    when a plugin left threads running: Python would wait for every non-daemon thread before it
+    exits, so one that never ends (a plugin's server, a forgotten loop) would keep the process, and
+    with it the terminal or the sweep's episode, forever. Those threads are named on stderr and the
+    process ends without waiting for them (``os._exit``, after flushing the standard streams)."""
+    left = [t for t in threading.enumerate() if t.is_alive() and not t.daemon and t is not threading.main_thread()]
+    if not left:
+        sys.exit(code)
+    names = ", ".join(sorted(t.name for t in left))
+    print(f"bearings: ending the process with exit code {code}; {len(left)} thread(s) a plugin left running: "
+          f"{names}", file=sys.stderr)
+    with contextlib.suppress(Exception):
+        sys.stdout.flush()
+        sys.stderr.flush()
+    os._exit(code)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    console()

@@ -24,6 +24,7 @@ from typing import Any
 
 from behaviours.ports import InputPort
 from behaviours.registry import Registry
+from maps.store import OutputFolders
 
 
 @dataclass(frozen=True)
@@ -91,3 +92,5 @@ class MissionSpec:
     cameras: tuple[str, ...] | None = None  # the cameras this mission grabs; None: every camera
     files: tuple[str, ...] = ()  # this file and every file it includes
     registry: Registry = field(default_factory=Registry.default, compare=False, repr=False)
+    # where the mission's files go (missions/outputs.py); None: paths are used as written
+    folders: OutputFolders | None = field(default=None, compare=False, repr=False)

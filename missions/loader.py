@@ -31,6 +31,7 @@ from missions.inputs import IDENT, bind, declaration, substitute
 from missions.language import MissionSpec, NodeSpec
 from missions.model import Evaluation, InputDeclaration, MissionFile
 from missions.nodes import NodeReader, Scope
+from missions.outputs import confinement_problems, output_folders
 from missions.plugins import PluginError, load_plugin
 
 LIBRARY = Path(__file__).parent / "library"
@@ -224,6 +225,7 @@ def load_mission(
     overrides: Mapping[str, str] | None = None,
     search_path: Iterable[str | os.PathLike] = (),
     registry: Registry | None = None,
+    output_dir: str | os.PathLike | None = None,
 ) -> MissionSpec:
     """Load and validate a mission file; raise :class:`InputError` listing every problem found.
 
@@ -231,7 +233,9 @@ def load_mission(
     inputs' types. ``search_path`` is where ``include:`` looks after the including file's folder
     (then ``$BEARINGS_PATH``, then the shipped mission library). ``registry`` is the set of node
     types the mission may use before its own plugins (default: built-ins and entry points); the
-    mission's plugins are added to a child of it, never to it.
+    mission's plugins are added to a child of it, never to it. ``output_dir``: where the mission's
+    files go (``--output-dir``; see :mod:`missions.outputs`: relative paths resolve there, and a
+    file written outside it and the mission's folder is refused).
     """
     env = [Path(p) for p in os.environ.get(PATH_ENV, "").split(os.pathsep) if p]
     loader = _Loader(search_path=[Path(p).resolve() for p in [*search_path, *env]],
@@ -249,6 +253,8 @@ def load_mission(
     tree = loader.reader.node(doc.data["tree"], doc.data.value_mark_of("tree"), scope, 0)
     evaluation = _evaluation(loader, doc, scope)
     cameras = _cameras(loader, doc, scope)
+    folders = output_folders(file_path, output_dir, LIBRARY)
+    loader.diagnostics.extend(confinement_problems([*sense, *([tree] if tree else [])], loader.registry, folders))
     if loader.diagnostics or tree is None:
         raise InputError(loader.diagnostics)
     header = doc.header
@@ -257,7 +263,7 @@ def load_mission(
         inputs=declared, values=values, sense=sense, plugins=tuple(loader.plugins), rate_hz=header.rate,
         max_time_s=header.max_time, overrun_s=header.overrun, evaluation=evaluation,
         files=tuple(dict.fromkeys(loader.files)),
-        cameras=cameras, registry=loader.registry,
+        cameras=cameras, registry=loader.registry, folders=folders,
     )  # fmt: skip
     problems = check_dataflow(mission)
     if problems:

@@ -245,7 +245,11 @@ class Runner:
         result = RunResult(status, reason, self.ticks, self.clock.now(), signum=self.monitor.signum)
         result.report = self._report(result)
         if self.options.report_path is not None:
-            write_json(self.options.report_path, result.report)
+            try:
+                write_json(self.options.report_path, result.report)
+            except OSError as exc:  # a full disk must not turn the run's outcome into a traceback
+                sys.stderr.write(f"bearings run: the report was not written to {self.options.report_path}: "
+                                 f"{exc.strerror or exc}; the run ended {status} ({reason})\n")
         return result
 
     def _emergency_exit(self, signum: int) -> None:

@@ -32,6 +32,7 @@ SQUARE_M = (1e-4, 1.0)  # side of a square in metres: 0.1 mm (printed micro-targ
 SAME_POSE_DEG = 2.0  # boards whose planes differ by less than this, ...
 SAME_POSE_SHIFT = 0.02  # ... and whose centres by less than this fraction of their distance, repeat a view
 MIN_TILT_DEG = 5.0  # the views' boards must differ in orientation by at least this much
+MIN_SQUARE_PX = 4  # a board square narrower than this in the image cannot be detected (OpenCV asserts below)
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,6 +76,16 @@ def check_square(square: float) -> None:
         raise ValueError(f"the side of a square must be {low:g} to {high:g} m, got {square}")
 
 
+def check_image_size(width: int, height: int, columns: int, rows: int) -> None:
+    """Raise ``ValueError`` when images this small cannot show the board (``MIN_SQUARE_PX`` per
+    square, in either orientation): OpenCV's detector fails on an assertion there, not a result."""
+    short, long = sorted((columns + 1, rows + 1))
+    need = (MIN_SQUARE_PX * short, MIN_SQUARE_PX * long)
+    if min(width, height) < need[0] or max(width, height) < need[1]:
+        raise ValueError(f"the images are {width}x{height} pixels: too small to show a {columns}x{rows} board "
+                         f"(at least {need[1]}x{need[0]}, {MIN_SQUARE_PX} pixels per square)")
+
+
 def board_points(columns: int, rows: int, square: float) -> np.ndarray:
     """Inner-corner positions of a ``columns`` x ``rows`` board on its own plane (z = 0), in m."""
     grid = np.mgrid[0:columns, 0:rows].T.reshape(-1, 2)
@@ -85,10 +96,13 @@ def find_corners(image: np.ndarray, columns: int, rows: int) -> np.ndarray | Non
     """Sub-pixel inner corners (N x 2 float32) of the board in ``image``, or None if not found."""
     gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
     flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
-    found, corners = cv2.findChessboardCorners(gray, (columns, rows), flags=flags)
-    if not found:
+    try:
+        found, corners = cv2.findChessboardCorners(gray, (columns, rows), flags=flags)
+        if not found:
+            return None
+        corners = cv2.cornerSubPix(gray, corners, (11, 11), (-1, -1), _SUBPIX_CRITERIA)
+    except cv2.error:  # an image OpenCV cannot search (too small, degenerate): the board is not in it
         return None
-    corners = cv2.cornerSubPix(gray, corners, (11, 11), (-1, -1), _SUBPIX_CRITERIA)
     return corners.reshape(-1, 2)
 
 
@@ -115,6 +129,7 @@ def calibrate_chessboard(
     if not images:
         raise ValueError("no images given")
     height, width = images[0].shape[:2]
+    check_image_size(width, height, columns, rows)
     corners, rejected = _detect_all(images, columns, rows)
     found = sorted(corners)
     if len(found) < min_views:

@@ -64,7 +64,7 @@ from typing import Any
 
 import numpy as np
 
-from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.ports import WRITES, InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import Drawn, roadmap_drawings, roadmap_figures, roadmap_section
 from behaviours.roadmap.homing import REQUIRED_ROOM, HomingSettings, home
@@ -79,6 +79,7 @@ from maps.planning import segment_is_free
 from maps.pose_graph import refine_targets
 from maps.roadmap import EdgeMotion, InconsistentEstimates, Roadmap
 from maps.room import RoomEstimate
+from maps.store import check_not_redirected
 from perception.geometry import Pose2D, wrap_angle
 
 TURN_NOISE = 0.01  # sigma per radian turned (calibrated turns)
@@ -130,7 +131,8 @@ class BuildGraph(RoutineBehaviour):
     """
 
     ROADMAP = InputPort("roadmap", Roadmap, Ref("/map/roadmap"), doc="the targets found (reference frame)")
-    FILE = InputPort("file", str, "", doc="where to save the roadmap ('' : do not save)")
+    FILE = InputPort("file", str, "", literal_only=True, file=WRITES,
+                        doc="where to save the roadmap ('' : do not save)")
     ROADMAP_OUT = OutputPort("roadmap_out", Roadmap, "/map/roadmap", doc="the roadmap with its edges")
     ROOM_OUT = OutputPort("room_out", RoomEstimate, "/map/room", doc="the room, anchored where the robot last homed")
     PORTS = (ROADMAP, TARGETS_IN, REFERENCE_IN, FILE, *REQUIRED_ROOM, *PLAN_PORTS, *ROUTINE_PORTS,
@@ -279,6 +281,7 @@ class BuildGraph(RoutineBehaviour):
         path = self.get_input(self.FILE)
         if path:
             try:
+                check_not_redirected(path)  # checked at load to lie in the output folder: no link since
                 relative_images(self.graph, path).save(path)
             except (OSError, ValueError) as exc:
                 raise Failed(f"cannot save the roadmap to {path}: {exc}") from None

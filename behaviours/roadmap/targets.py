@@ -23,7 +23,7 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.ports import InputPort, OutputPort, Ref
+from behaviours.ports import READS, InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import Drawn, roadmap_drawings, roadmap_figures, roadmap_section
 from behaviours.roadmap.values import HomingResult, TargetImages, TargetView
@@ -85,7 +85,8 @@ class LoadTargetImages(BearingsBehaviour):
     FAILURE, saying why, when the folder is missing or empty or an image cannot be read.
     """
 
-    FOLDER = InputPort("folder", str, doc="folder of target images (PNG, JPEG, ...); target name = file name")
+    FOLDER = InputPort("folder", str, file=READS,
+                       doc="folder of target images (PNG, JPEG, ...); target name = file name")
     PORTS = (FOLDER, MAX_FEATURES, TARGETS_OUT)
 
     def update(self) -> Status:
@@ -104,7 +105,7 @@ class LoadTargetImages(BearingsBehaviour):
 class LoadRoadmap(BearingsBehaviour):
     """Read a roadmap file and the target images it names (paths relative to the file's folder)."""
 
-    FILE = InputPort("file", str, doc="roadmap file written by learn_targets")
+    FILE = InputPort("file", str, file=READS, doc="roadmap file written by learn_targets")
     ROADMAP = OutputPort("roadmap", Roadmap, "/map/roadmap", doc="targets (reference frame) and edges")
     PORTS = (FILE, MAX_FEATURES, ROADMAP, TARGETS_OUT)
 

@@ -66,6 +66,12 @@ class SimClock:
         self._now = self._ticks * period
 
 
+WATCHDOG_S = 2.0
+"""The simulated base stops when no command arrives for this long, as a Pioneer's firmware does
+(its config packet's Watchdog, 2000 ms; docs/protocols.md): a mission that leaves the base to run
+on without commands stops in the simulator as it would on the robot."""
+
+
 class SimBase:
     """The :class:`~drivers.interfaces.Base` of the simulated robot."""
 
@@ -75,6 +81,7 @@ class SimBase:
 
     def drive(self, v: float, w: float) -> None:
         self.commands.append((self._sim.time, float(v), float(w)))
+        self._sim.last_command = self._sim.time
         self._sim.drive.command(v, w)
 
     def stop(self) -> None:
@@ -124,6 +131,7 @@ class Simulation:
         self.scene = Scene(self.world)
         self.crowd = Crowd(self.world.people)
         self.time = 0.0
+        self.last_command = 0.0  # when the base last heard a drive command (the watchdog's clock)
         self.stalled = False
         self.collisions = 0
         self.collisions_with_people = 0
@@ -172,9 +180,12 @@ class Simulation:
         it was) ends where the disc touches (within :data:`CONTACT_PRECISION_M`): the base stops
         there, its wheels and odometry included, the contact is counted (once per episode), and
         :meth:`SimBase.stalled` is True until a command moves it away. Then the people walk
-        (:class:`~drivers.sim.people.Crowd`: they wait for the robot rather than walk into it).
+        (:class:`~drivers.sim.people.Crowd`: they wait for the robot rather than walk into it). A base
+        that has heard no command for :data:`WATCHDOG_S` stops, as the robot's firmware stops it.
         """
         drive = self.drive
+        if self.time - self.last_command >= WATCHDOG_S - 1e-9 and drive.target != (0.0, 0.0):
+            drive.command(0.0, 0.0)  # the firmware's watchdog: no command for WATCHDOG_S, the base stops
         before_true, before_odom = drive.true_pose.copy(), drive.odom_pose.copy()
         drive.step(dt, blocked=False)
         after_true, after_odom = drive.true_pose.copy(), drive.odom_pose.copy()

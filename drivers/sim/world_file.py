@@ -8,8 +8,10 @@ and radians in ``World``.
 
 Every quantity is bounded so that loading and rendering a world takes memory and time in
 proportion to what it declares: coordinates within 10 km (landmarks within 100 km, for
-horizons), heights and radii within 100 m, at most a few thousand surfaces, and a texture
-budget for the whole world (:data:`MAX_TEXTURE_TEXELS`).
+horizons), heights and radii within 100 m, at most a few thousand surfaces, a texture budget for
+the whole world (:data:`MAX_TEXTURE_TEXELS`) and a rendering budget for its cameras
+(:data:`MAX_RENDER_BYTES`: pixels times the renderer's memory per pixel, which ``bearings bench
+sim`` measures), so no camera can take the machine's memory.
 """
 
 from __future__ import annotations
@@ -32,6 +34,11 @@ MAX_TEXTURE_SIDE = 16_000  # texels: one surface's texture must fit the atlas (c
 MAX_TEXTURE_TEXELS = 200_000_000  # all surfaces together: about 200 MB of 8-bit texture
 MAX_PEOPLE = 200
 MAX_PATH_POINTS = 1_000
+RENDER_BYTES_PER_PIXEL = 720  # peak memory per pixel of a camera rendered through lookup tables (pinhole,
+# stereo, catadioptric, a tilted panorama): every pixel's bearing, the remap tables, the source panorama;
+# bearings bench sim measures it (render_bytes_per_pixel: ~690 for a pinhole)
+LEVEL_PANORAMA_BYTES_PER_PIXEL = 32  # a level panorama on the base is ray-cast directly (measured: ~20)
+MAX_RENDER_BYTES = 4_000_000_000  # all of a world's cameras together
 
 
 def _m(description: str, **bounds: Any) -> Any:
@@ -285,6 +292,17 @@ class Camera(BaseModel):
         self.image_model()  # the perception model's own checks, reported with the file's other problems
         return self
 
+    def render_bytes(self) -> int:
+        """The renderer's peak memory for this camera (0 for the bearings sensor): its pixels (both
+        images of a stereo pair) times the measured bytes per pixel of its way of rendering."""
+        model = self.image_model()
+        if model is None:
+            return 0
+        eyes = [model.left, model.right] if isinstance(model, StereoRig) else [model]
+        pixels = sum(eye.width * eye.height for eye in eyes)
+        level = self.kind == "panorama" and self.mount == "base" and (self.pose is None or self.pose.pitch_deg == 0)
+        return pixels * (LEVEL_PANORAMA_BYTES_PER_PIXEL if level else RENDER_BYTES_PER_PIXEL)
+
     def image_model(self) -> Any:
         """The perception camera model of an image camera (None for the bearings sensor)."""
         if self.kind == "bearings":
@@ -364,6 +382,17 @@ class WorldFile(BaseModel):
     ptu: PanTiltUnit = Field(default_factory=PanTiltUnit)
     cameras: list[Camera] | None = Field(None, min_length=1, max_length=32, description="default: one of each kind")
     lighting: Lighting = Field(default_factory=Lighting)
+
+    @field_validator("cameras")
+    @classmethod
+    def _render_budget(cls, cameras: list[Camera] | None) -> list[Camera] | None:
+        total = sum(camera.render_bytes() for camera in cameras or ())
+        if total > MAX_RENDER_BYTES:
+            raise ValueError(f"rendering them would take about {total / 1e9:.1f} GB (at most "
+                             f"{MAX_RENDER_BYTES / 1e9:.0f} GB: {RENDER_BYTES_PER_PIXEL} bytes per pixel, "
+                             f"{LEVEL_PANORAMA_BYTES_PER_PIXEL} for a level panorama, as bearings bench sim "
+                             "measures): fewer or smaller cameras")
+        return cameras
 
     @model_validator(mode="after")
     def _texture_budget(self) -> WorldFile:

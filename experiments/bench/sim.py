@@ -12,21 +12,32 @@
   three transducers per ring fire), what the runner's sensing branch adds to every tick.
 - ``other_cameras_ms``: per-frame times of the other rendered cameras in ``lab`` (after their
   lookup tables are built).
+- ``render_bytes_per_pixel``: the renderer's peak memory per pixel (``pinhole``: through lookup
+  tables, as every camera but a level panorama; ``level_panorama``: ray-cast directly), the
+  growth of a fresh process's peak resident memory between two sizes of one camera, divided by
+  the pixels added; ``render_bytes_per_pixel_budgeted``: the figures the world loader budgets
+  cameras with (``drivers.sim.world_file``), which must not be below the measured ones.
 """
 
 from __future__ import annotations
 
 import functools
+import json
 import math
+import os
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import replace
+from pathlib import Path
 
 import cv2
 import numpy as np
 
 from drivers.sim.simulation import Simulation
 from drivers.sim.world import load_world
+from drivers.sim.world_file import LEVEL_PANORAMA_BYTES_PER_PIXEL, RENDER_BYTES_PER_PIXEL
 from drivers.sim.world_values import Person, TextureSpec
 from perception.geometry import Pose2D
 
@@ -107,6 +118,9 @@ def _measure(quick: bool) -> dict:
         sim.snapshot(start, name)
         others[name] = round(1e3 / _rate(functools.partial(_snapshot_at, sim, start, name), max(5, n // 20)), 3)
     figures["other_cameras_ms"] = others
+    figures["render_bytes_per_pixel"] = render_bytes_per_pixel(quick)
+    figures["render_bytes_per_pixel_budgeted"] = {"pinhole": RENDER_BYTES_PER_PIXEL,
+                                                  "level_panorama": LEVEL_PANORAMA_BYTES_PER_PIXEL}
     return figures
 
 
@@ -115,6 +129,57 @@ def _lab_with_people() -> Simulation:
     people = tuple(Person(path, 0.25, 1.75, TextureSpec(seed=500 + i, feature_size=0.1, brightness=90.0))
                    for i, path in enumerate(WALKERS))
     return Simulation(replace(lab, people=people, name="lab_people"), seed=0)
+_PEAK_RSS = """
+import json, sys, tempfile
+from drivers.sim.simulation import Simulation
+from maps.store import dump_yaml, load_yaml
+
+def peak():  # this process's own high-water mark (getrusage's can start at the parent's, from the fork)
+    status = open("/proc/self/status").read().split("VmHWM:")[1]
+    return int(status.split()[0]) * 1024
+
+world = dict(load_yaml(sys.argv[1]))
+camera = {"name": "measured", "kind": sys.argv[2], "mount": "base", "pose": {"z": 0.9},
+          "model": json.loads(sys.argv[3])}
+warm = {"name": "warm", "kind": "pinhole", "mount": "base", "pose": {"z": 0.9},
+        "model": {"width": 32, "height": 24, "fx": 25.0, "fy": 25.0, "cx": 15.5, "cy": 11.5}}
+world["cameras"] = [camera, warm]
+with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as handle:
+    handle.write(dump_yaml(world))
+sim = Simulation.load(handle.name, seed=0)
+sim.snapshot(sim.world.start, "warm")  # textures and the process's own growth, before the measurement
+before = peak()
+sim.snapshot(sim.world.start, "measured")
+print(peak() - before)
+"""
+
+
+def render_bytes_per_pixel(quick: bool) -> dict[str, int]:
+    """Per way of rendering, the peak memory per pixel (see the module doc): each size measured in a
+    fresh process, since a process's peak never comes down."""
+    scale = 1 if quick else 2
+    sizes = {"pinhole": ("pinhole", [(320 * scale * k, 240 * scale * k) for k in (1, 2)]),
+             "level_panorama": ("panorama", [(720 * scale * k, 172 * scale * k) for k in (1, 2)])}
+    figures = {}
+    for name, (kind, (small, large)) in sizes.items():
+        peaks = [(w * h, _peak_rss(kind, _model(kind, w, h))) for w, h in (small, large)]
+        figures[name] = round((peaks[1][1] - peaks[0][1]) / (peaks[1][0] - peaks[0][0]))
+    return figures
+
+
+def _model(kind: str, width: int, height: int) -> dict:
+    if kind == "pinhole":
+        return {"width": width, "height": height, "fx": 0.8 * width, "fy": 0.8 * width, "cx": width / 2 - 0.5,
+                "cy": height / 2 - 0.5}
+    return {"width": width, "height": height, "deg_per_px": 360.0 / width, "horizon_row": height // 3}
+
+
+def _peak_rss(kind: str, model: dict) -> int:
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in (str(root), os.environ.get("PYTHONPATH")) if p)}
+    done = subprocess.run([sys.executable, "-c", _PEAK_RSS, str(root / "drivers" / "worlds" / "lab.yaml"), kind,
+                           json.dumps(model)], capture_output=True, text=True, check=True, env=env, timeout=600)
+    return int(done.stdout.split()[-1])
 
 
 def _snapshot_on_path(sim: Simulation, poses: list[Pose2D], i: int) -> object:

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import json
 import sys
 
 from experiments.bench import AREAS
+from maps.store import json_text
 from missions.commands.common import EXIT_INVALID, EXIT_OK
 
 
@@ -34,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
     figures = module.run(quick=args.quick)
     figures = {"area": args.area, **figures}
     if args.json:
-        print(json.dumps(figures, indent=2))
+        print(json_text(figures, indent=2))
     else:
         width = max(len(k) for k in figures)
         for key, value in figures.items():

@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib
-import json
 import sys
 import tempfile
 from pathlib import Path
@@ -19,9 +18,11 @@ from typing import Any
 
 from experiments.eval import AREAS, EvalOptions
 from experiments.sweep import SweepError, SweepInputError, SweepInterrupted, executor_for
-from experiments.sweep.sweeper import progress_stream
+from experiments.sweep.lifeline import lifeline
+from experiments.sweep.sweeper import cap_workers, prepare_results_folder, progress_stream
 from experiments.sweep.table import TABLE
-from maps.store import InputError
+from experiments.sweep.worker import run_number_problem
+from maps.store import InputError, json_text
 from missions.commands.common import EXIT_FAILURE, EXIT_OK, fail, print_input_error
 
 MAX_SEEDS = 10_000
@@ -60,10 +61,9 @@ def _problem(args: argparse.Namespace) -> str | None:
         return f"--seeds must be 1 to {MAX_SEEDS}, got {args.seeds}"
     if args.workers is not None and args.workers < 1:
         return f"--workers must be at least 1, got {args.workers}"
-    for name in ("timeout", "max_time"):
-        value = getattr(args, name)
-        if value is not None and not value > 0:
-            return f"--{name.replace('_', '-')} must be positive, got {value:g}"
+    problem = run_number_problem(args.max_time, args.timeout)
+    if problem:
+        return problem
     if args.resume and args.output is None:
         return "--resume needs -o DIR"
     if args.output is not None and not args.resume and (args.output / TABLE).exists():
@@ -98,14 +98,17 @@ def run(args: argparse.Namespace) -> int:
         world = module.check_world(args.world)
         extra = area_options(module, args.area, args.option)
         settings = module.check_options(args.world, extra) if hasattr(module, "check_options") else None
+        if args.output is not None:
+            prepare_results_folder(args.output)
     except InputError as exc:
         return print_input_error(exc)
-    except ValueError as exc:
+    except ValueError as exc:  # SweepInputError too
         return fail("eval", str(exc))
     with contextlib.ExitStack() as stack:
+        stack.enter_context(lifeline("eval"))  # whatever ends the evaluation, its processes and folders end with it
         folder = args.output or Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="bearings-eval-")))
         try:
-            executor = stack.enter_context(executor_for(args.workers, args.cluster))
+            executor = stack.enter_context(executor_for(cap_workers(args.workers, "eval"), args.cluster))
             options = EvalOptions(args.world, list(range(args.seeds)), executor, folder, args.timeout,
                                   args.max_time, progress_stream(args.progress), extra, (world, settings))
             figures = module.run(options, resume=args.resume)
@@ -115,5 +118,5 @@ def run(args: argparse.Namespace) -> int:
             print(f"bearings eval: {exc}", file=sys.stderr)
             return EXIT_FAILURE
     figures = {"area": args.area, **figures}
-    print(json.dumps(figures, indent=2) if args.json else module.format_table(figures))
+    print(json_text(figures, indent=2) if args.json else module.format_table(figures))
     return EXIT_OK

@@ -4,25 +4,29 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import re
-import signal
 import sys
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
 from experiments.sweep import episode as spec
+from experiments.sweep.lifeline import lifeline
 from experiments.sweep.summary import format_summary, plot, resolve_column, summarise
 from experiments.sweep.sweeper import (
     SweepError,
     SweepInterrupted,
+    cap_workers,
     check_episodes,
     default_workers,
     executor_for,
+    prepare_results_folder,
     progress_stream,
     run_sweep,
 )
-from experiments.sweep.table import SUMMARY, TABLE, TornLineWarning, load_table
+from experiments.sweep.table import OUTPUTS, SUMMARY, TABLE, TornLineWarning, load_table
+from experiments.sweep.worker import run_number_problem
 from maps.store import write_json
 from missions.commands.common import EXIT_FAILURE, EXIT_OK, fail
 
@@ -88,7 +92,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     with _one_line_warnings():
-        return _run(args)
+        if args.summary is not None:
+            return _run(args)
+        with lifeline("sweep"):  # whatever ends the sweep, its processes and temporary folders end with it
+            return _run(args)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -98,12 +105,11 @@ def _run(args: argparse.Namespace) -> int:
         return _show(args.summary, args)
     try:
         episodes = _episodes(args)
-        with executor_for(args.workers, args.cluster) as executor:
+        with executor_for(cap_workers(args.workers, "sweep"), args.cluster) as executor:
             check_episodes(episodes, executor, start_method=args.start_method)
-            with _sigterm_as_interrupt():
-                run_sweep(episodes, executor=executor, results_dir=args.output, timeout_s=args.timeout,
-                          resume=args.resume, retry_errors=args.retry_errors, progress=progress_stream(args.progress),
-                          start_method=args.start_method)
+            run_sweep(episodes, executor=executor, results_dir=args.output, timeout_s=args.timeout,
+                      resume=args.resume, retry_errors=args.retry_errors, progress=progress_stream(args.progress),
+                      start_method=args.start_method)
     except spec.SweepInputError as exc:  # bad options, a run command's diagnostic, no cluster
         return fail("sweep", str(exc))
     except SweepInterrupted as exc:
@@ -122,8 +128,6 @@ def _episodes(args: argparse.Namespace) -> list[spec.Episode]:
     """The grid the options describe; :class:`SweepInputError` for any invalid option."""
     if not args.mission or args.output is None:
         raise spec.SweepInputError("give MISSION and -o RESULTS_DIR (or --summary RESULTS_DIR)")
-    if args.output.exists() and not args.output.is_dir():
-        raise spec.SweepInputError(f"-o {args.output}: not a folder")
     problem = _check_plot_options(args)
     if problem:
         raise spec.SweepInputError(problem)
@@ -131,14 +135,17 @@ def _episodes(args: argparse.Namespace) -> list[spec.Episode]:
         raise spec.SweepInputError("--retry-errors goes with --resume")
     if args.workers is not None and args.workers < 1:
         raise spec.SweepInputError("--workers must be at least 1")
-    for name, value in (("--timeout", args.timeout), ("--max-time", args.max_time)):
-        if value is not None and not value > 0:
-            raise spec.SweepInputError(f"{name} must be positive")
+    problem = run_number_problem(args.max_time, args.timeout)
+    if problem:
+        raise spec.SweepInputError(problem)
     mission = spec.absolute_if_file(args.mission)
     worlds = spec.parse_worlds(args.sim)
     seeds = spec.parse_seeds(args.seeds)
     sets = spec.parse_sets(args.sets)
-    return spec.grid(mission, worlds, seeds, sets, max_time_s=args.max_time)
+    episodes = spec.grid(mission, worlds, seeds, sets, max_time_s=args.max_time)
+    prepare_results_folder(args.output)
+    outputs = args.output.resolve() / OUTPUTS  # each run's files apart: runs of one mission name the same ones
+    return [dataclasses.replace(e, output_dir=str(outputs / e.id)) for e in episodes]
 
 
 @contextlib.contextmanager
@@ -152,20 +159,6 @@ def _one_line_warnings() -> Iterator[None]:
         warnings.simplefilter("default", TornLineWarning)
         warnings.showwarning = show
         yield
-
-
-@contextlib.contextmanager
-def _sigterm_as_interrupt() -> Iterator[None]:
-    """SIGTERM (a batch system ending the job) stops the sweep as Ctrl-C does: rows kept, runs killed."""
-
-    def interrupt(_signum: int, _frame: object) -> None:
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGTERM, interrupt)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 def _finish(folder: Path, args: argparse.Namespace) -> int:

@@ -31,12 +31,12 @@ def die_with_parent(parent: int | None = None) -> None:
         os._exit(70)  # the parent died before the signal was armed
 
 
-def main() -> int:
+def main() -> None:
     die_with_parent()
-    from missions.cli import main as cli_main
+    from missions.cli import console
 
-    return cli_main(sys.argv[1:])
+    console(sys.argv[1:])  # ends the process after the run, whatever threads a plugin left
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -20,6 +20,8 @@ from typing import Any
 
 import yaml
 
+from maps.located import describe_value
+
 MAX_EPISODES = 100_000
 """The largest grid a sweep accepts (a typo like ``--seeds 0-9999999`` is an input error)."""
 
@@ -38,8 +40,10 @@ class Episode:
     """One ``bearings run``: ``mission`` (file or shipped name), ``world`` (shipped name or file,
     ``"empty"`` for the empty plane), ``seed``, ``inputs`` (``--set name=value``; values are YAML
     text as on the command line, or plain scalars), ``max_time_s`` (the run's ``--max-time``,
-    simulated seconds; None: the mission's own limit) and ``start`` (the run's ``--start``: a
-    start pose ``x,y,theta`` or a named pose of the world; None: the world's start)."""
+    simulated seconds; None: the mission's own limit), ``start`` (the run's ``--start``: a
+    start pose ``x,y,theta`` or a named pose of the world; None: the world's start) and
+    ``output_dir`` (the run's ``--output-dir``, where the files the mission writes go; where the
+    episode writes is not what it is, so it is not part of the id)."""
 
     mission: str
     world: str = "empty"
@@ -47,6 +51,7 @@ class Episode:
     inputs: Mapping[str, Any] = field(default_factory=dict)
     max_time_s: float | None = None
     start: str | None = None
+    output_dir: str | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inputs", {str(k): v for k, v in sorted(dict(self.inputs).items())})
@@ -97,6 +102,8 @@ class Episode:
             argv += ["--max-time", repr(float(self.max_time_s))]
         if self.start is not None:
             argv.append(f"--start={self.start}")  # '=': a pose may start with a minus sign
+        if self.output_dir is not None:
+            argv += ["--output-dir", str(self.output_dir)]
         return argv
 
 
@@ -135,6 +142,8 @@ def parse_seeds(spec: str) -> list[int]:
     for part in spec.split(","):
         text = part.strip()
         match = re.fullmatch(r"(\d+)(?:-(\d+))?", text)
+        if match and max(len(n or "") for n in match.groups()) > len(str(MAX_SEED)):
+            raise SweepInputError(f"--seeds: seeds go from 0 to {MAX_SEED}, got {describe_value(text)}")
         if not match:
             raise SweepInputError(f"--seeds {spec}: expected N, A-B or a comma-separated list of them, got {text!r}")
         first = int(match.group(1))

@@ -78,13 +78,20 @@ def summarise(rows: Sequence[Row]) -> list[dict[str, Any]]:
         for name in figures:
             values = [m[name] for m in members if is_number(m.get(name))]
             if values:
-                entry["figures"][name] = {
-                    "n": len(values), "mean": statistics.fmean(values),
-                    "std": statistics.stdev(values) if len(values) > 1 else 0.0,
-                    "min": min(values), "max": max(values),
-                }
+                mean, std = mean_and_spread(values)
+                entry["figures"][name] = {"n": len(values), "mean": mean, "std": std,
+                                          "min": min(values), "max": max(values)}
         out.append(entry)
     return sorted(out, key=lambda e: [_order(e[k]) for k in params])
+
+
+def mean_and_spread(values: Sequence[float]) -> tuple[float, float]:
+    """Mean and sample standard deviation (0 for one value) of finite numbers, whatever their size:
+    computed on the values divided by the largest magnitude, so 1e308 figures do not overflow."""
+    scale = max(abs(float(v)) for v in values) or 1.0
+    scaled = [float(v) / scale for v in values]
+    spread = statistics.stdev(scaled) if len(scaled) > 1 else 0.0
+    return statistics.fmean(scaled) * scale, spread * scale  # an inf spread becomes null in JSON
 
 
 def format_summary(summary: Sequence[dict[str, Any]], figures: Sequence[str] | None = None) -> str:
@@ -180,8 +187,7 @@ def _plot_line(ax: Any, members: list[Row], figure: str, against: str, position:
     if not by_x:
         return
     xs = sorted(by_x)
-    means = [statistics.fmean(by_x[x]) for x in xs]
-    stds = [statistics.stdev(by_x[x]) if len(by_x[x]) > 1 else 0.0 for x in xs]
+    means, stds = zip(*(mean_and_spread(by_x[x]) for x in xs), strict=True)
     line = ax.errorbar(xs, means, yerr=stds, marker="o", capsize=3, label=label)
     scatter_x = [x for x in xs for _ in by_x[x]]
     scatter_y = [v for x in xs for v in by_x[x]]

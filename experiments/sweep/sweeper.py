@@ -9,6 +9,7 @@ the episode in its own process, so nothing an episode does can break the executo
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import fcntl
 import functools
 import multiprocessing
@@ -26,6 +27,7 @@ from concurrent.futures import wait as wait_futures
 from pathlib import Path
 from typing import Any, TextIO
 
+from experiments.sweep.child import die_with_parent
 from experiments.sweep.episode import Episode, SweepInputError
 from experiments.sweep.table import LOGS, REPORTS, TABLE, Journal, latest_by_id, make_row, read_rows, write_sorted
 from experiments.sweep.worker import START_METHODS, EpisodeResult, StopToken, run_episode
@@ -64,16 +66,56 @@ def default_workers() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def _ignore_sigint() -> None:
+WORKER_BYTES = 256 * 1024 * 1024
+"""Memory one local worker takes with its episode server and the episode it runs (about 170 MB
+measured for the shipped worlds, rounded up): workers beyond what the machine's free memory holds
+would only swap or be killed."""
+
+
+def worker_limit() -> tuple[int, str]:
+    """The most local workers this machine has room for, and why: its cores, or its free memory."""
+    cores = default_workers()
+    available = _available_memory()
+    if available is not None and available // WORKER_BYTES < cores:
+        return max(1, available // WORKER_BYTES), f"the free memory, {available / 2**30:.1f} GiB"
+    return cores, "the cores this process may use"
+
+
+def cap_workers(requested: int | None, command: str) -> int | None:
+    """``--workers`` capped at :func:`worker_limit`, saying so on stderr (a worker and an episode
+    server per requested worker would start, whatever the machine has)."""
+    if requested is None:
+        return None
+    limit, why = worker_limit()
+    if requested <= limit:
+        return requested
+    print(f"bearings {command}: --workers {requested} capped at {limit} ({why})", file=sys.stderr)
+    return limit
+
+
+def _available_memory() -> int | None:
+    """MemAvailable of /proc/meminfo in bytes (Linux); None where it cannot be read."""
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def _start_worker(sweep: int) -> None:
     # A terminal's Ctrl-C reaches the whole process group; the sweep alone decides what to stop.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    die_with_parent(sweep)  # a killed sweep takes its workers (and so their servers and episodes) along
 
 
 def local_executor(workers: int | None = None) -> ProcessPoolExecutor:
     """A process pool for sweeps on this machine. Workers start with ``spawn`` (no inherited
-    threads or locks) and ignore SIGINT: on Ctrl-C the sweep stops their episodes itself."""
-    return ProcessPoolExecutor(max_workers=workers or default_workers(), initializer=_ignore_sigint,
-                               mp_context=multiprocessing.get_context("spawn"))
+    threads or locks), ignore SIGINT (on Ctrl-C the sweep stops their episodes itself) and die
+    with the sweep's process, however it ends (see :mod:`experiments.sweep.lifeline`)."""
+    return ProcessPoolExecutor(max_workers=workers or default_workers(), initializer=_start_worker,
+                               initargs=(os.getpid(),), mp_context=multiprocessing.get_context("spawn"))
 
 
 CONNECT_TIMEOUT_S = 10.0
@@ -102,8 +144,10 @@ def executor_for(workers: int | None, cluster: str | None) -> Iterator[Executor]
         pool = local_executor(workers)
         try:
             yield pool
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+        except BaseException:  # Ctrl-C during a pre-flight check, say: do not wait for what runs (the
+            pool.shutdown(wait=False, cancel_futures=True)  # command's lifeline ends it)
+            raise
+        pool.shutdown(wait=True, cancel_futures=True)
         return
     stack = contextlib.ExitStack()
     try:
@@ -114,6 +158,22 @@ def executor_for(workers: int | None, cluster: str | None) -> Iterator[Executor]
         raise SweepInputError(f"cannot reach the Dask scheduler at {cluster}: {exc}") from None
     with stack:
         yield executor
+
+
+def prepare_results_folder(folder: str | os.PathLike) -> None:
+    """Create a results folder (and its parents) and make sure files can be created in it;
+    :class:`SweepInputError` in one line when it cannot be used (a file in the way, ``/proc``, a
+    read-only disk). A file is created and removed rather than ``os.access`` asked: root passes
+    every permission check and still cannot write to a read-only file system."""
+    path = Path(folder)
+    if path.exists() and not path.is_dir():
+        raise SweepInputError(f"{path}: not a folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise SweepInputError(f"{path}: cannot write results there ({exc.strerror or exc})") from None
 
 
 def run_sweep(
@@ -140,12 +200,16 @@ def run_sweep(
     (their new rows replace them). ``progress``: a stream for the progress line.
     ``start_method``: how each episode's process starts, ``fork`` (from a warm server per worker,
     the default) or ``spawn`` (a fresh interpreter); see :mod:`experiments.sweep.worker`.
+    Episodes without an ``output_dir`` write their files (``--output-dir``) in ``results_dir``.
 
     Raises :class:`SweepInterrupted` on Ctrl-C (finished rows kept, running episodes killed) and
     :class:`SweepError` when the executor lost episodes; both carry the recorded rows.
     """
     if start_method not in START_METHODS:
         raise ValueError(f"start_method must be one of {', '.join(START_METHODS)}, not {start_method!r}")
+    if results_dir is not None:
+        folder = str(Path(results_dir).resolve())
+        episodes = [e if e.output_dir is not None else dataclasses.replace(e, output_dir=folder) for e in episodes]
     unique = {episode.id: episode for episode in episodes}
     with _Workspace(results_dir, resume) as space:
         done = {i: row for i, row in space.existing.items()
@@ -164,6 +228,11 @@ def run_sweep(
         except KeyboardInterrupt:
             rows = sorted([*done.values(), *space.recorded], key=lambda r: r["id"])
             raise SweepInterrupted(rows, len(unique)) from None
+        except OSError as exc:  # the results folder failed under the sweep (a full disk): stop, keep what is there
+            rows = sorted([*done.values(), *space.recorded], key=lambda r: r["id"])
+            recorded = {row["id"] for row in rows}
+            raise SweepError(f"cannot record results in {space.folder}: {exc.strerror or exc}", rows,
+                             [e.id for e in todo if e.id not in recorded]) from None
         finally:
             if owned:  # waits for the running tasks, which see the stop token and kill their episodes
                 executor.shutdown(wait=True, cancel_futures=True)
@@ -194,7 +263,7 @@ def check_episodes(episodes: Sequence[Episode], executor: Executor, *, timeout_s
     own per-run limit)."""
     checks: dict[tuple, Episode] = {}
     for e in episodes:
-        probe = Episode(e.mission, e.world, e.seed, e.inputs, CHECK_TIME_S, e.start)
+        probe = dataclasses.replace(e, max_time_s=CHECK_TIME_S)
         checks.setdefault(("world", e.mission, e.world), probe)
         checks.setdefault(("inputs", e.mission, tuple(e.input_text.items())), probe)
     probes = list(dict.fromkeys(checks.values()))
@@ -279,7 +348,7 @@ class _Workspace:
             self._scratch = tempfile.mkdtemp(prefix="bearings-sweep-")
             self.stop_path = Path(self._scratch) / "stop"
             return self
-        self.folder.mkdir(parents=True, exist_ok=True)
+        prepare_results_folder(self.folder)
         self._lock(self.folder)
         self.stop_path = self.folder / ".stop"
         self.existing = latest_by_id(read_rows(self.folder / TABLE))
@@ -298,8 +367,10 @@ class _Workspace:
         if self.journal is not None and self.folder is not None:
             self.journal.close()
             # the table holds what it held at the start (``existing``) and the rows appended since
-            # (``recorded``): sorted from memory, not read again
-            write_sorted(self.folder / TABLE, latest_by_id([*self.existing.values(), *self.recorded]).values())
+            # (``recorded``): sorted from memory, not read again; if that fails (a full disk) the
+            # journal keeps every row, unsorted
+            with contextlib.suppress(OSError):
+                write_sorted(self.folder / TABLE, latest_by_id([*self.existing.values(), *self.recorded]).values())
         self._unlock()
 
     def record(self, episode: Episode, result: EpisodeResult) -> Row:

@@ -26,12 +26,13 @@ from typing import Any
 
 from experiments.sweep.episode import Episode
 from experiments.sweep.worker import EpisodeResult
-from maps.store import write_text_atomic
+from maps.store import json_text, write_text_atomic
 
 TABLE = "results.jsonl"
 REPORTS = "reports"
 LOGS = "logs"
 SUMMARY = "summary.json"
+OUTPUTS = "outputs"  # a sweep's runs write their files in outputs/<id>/ (their --output-dir)
 
 WALL_TIME_KEYS = frozenset({"wall_time_s", "elapsed_s"})
 """Row keys that measure wall-clock time: the only figures that differ between two runs of the same
@@ -66,13 +67,15 @@ def make_row(episode: Episode, result: EpisodeResult) -> dict[str, Any]:
     return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in row.items()}
 
 
-def flatten(data: dict[str, Any], prefix: str) -> dict[str, Any]:
-    """Scalars of nested mappings under dotted keys; lists are left out."""
+def flatten(data: dict[str, Any], prefix: str, depth: int = 1) -> dict[str, Any]:
+    """Scalars of nested mappings under dotted keys; lists (and what is nested deeper than
+    :data:`MAX_ROW_DEPTH`, which a report's figures never are) are left out."""
     out: dict[str, Any] = {}
     for key, value in data.items():
         name = f"{prefix}.{key}"
         if isinstance(value, dict):
-            out.update(flatten(value, name))
+            if depth < MAX_ROW_DEPTH:
+                out.update(flatten(value, name, depth + 1))
         elif value is None or isinstance(value, (bool, int, float, str)):
             out[name] = value
     return out
@@ -101,7 +104,7 @@ class Journal:
         _cut_torn_tail(self.fd, path)
 
     def append(self, row: dict[str, Any]) -> None:
-        line = (json.dumps(row, separators=(",", ":"), default=str) + "\n").encode("utf-8")
+        line = (json_text(row, separators=(",", ":"), default=str) + "\n").encode("utf-8")
         written = os.write(self.fd, line)
         if written != len(line):  # a full disk: say so rather than leave half a row
             raise OSError(f"{self.path}: short write ({written} of {len(line)} bytes)")
@@ -151,15 +154,32 @@ def read_rows(path: Path) -> list[dict[str, Any]]:
             continue
         try:
             row = json.loads(line)
-            if not isinstance(row, dict) or "id" not in row:
+            if not _is_row(row):
                 raise ValueError("not a row")
-        except ValueError:
+        except (ValueError, RecursionError):  # RecursionError: nested deeper than the parser goes
             torn = number == len(lines)  # the last line, without its newline
             what = "a torn last line" if torn else f"line {number}: not a JSON row"
             warnings.warn(f"{path}: ignoring {what}", TornLineWarning, stacklevel=2)
             continue
         rows.append(row)
     return rows
+
+
+MAX_ROW_DEPTH = 8
+"""Rows are flat (a value may be a list of inputs): nesting deeper than this is not a row."""
+
+
+def _is_row(row: Any) -> bool:
+    """A mapping with a non-empty text ``id`` and values nested at most :data:`MAX_ROW_DEPTH` deep."""
+    if not isinstance(row, dict) or not isinstance(row.get("id"), str) or not row["id"]:
+        return False
+    level: list[Any] = [row]
+    for _ in range(MAX_ROW_DEPTH):
+        level = [v for item in level for v in (item.values() if isinstance(item, dict) else item)
+                 if isinstance(v, (dict, list))]
+        if not level:
+            return True
+    return False
 
 
 def latest_by_id(rows: Iterable[dict[str, Any]]) -> dict[str, dict[str, Any]]:
@@ -172,7 +192,7 @@ def latest_by_id(rows: Iterable[dict[str, Any]]) -> dict[str, dict[str, Any]]:
 
 def write_sorted(path: Path, rows: Iterable[dict[str, Any]]) -> None:
     """Rewrite the table atomically: one row per id, sorted by id."""
-    lines = [json.dumps(row, separators=(",", ":"), default=str) + "\n" for row in rows]
+    lines = [json_text(row, separators=(",", ":"), default=str) + "\n" for row in rows]
     write_text_atomic(path, "".join(lines))
 
 
@@ -181,7 +201,7 @@ def read_report(results_dir: str | os.PathLike, episode_id: str) -> dict[str, An
     unreadable one (its row says why: the run is an ERROR)."""
     try:
         report = json.loads((Path(results_dir) / REPORTS / f"{episode_id}.json").read_text())
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
     return report if isinstance(report, dict) else None
 
@@ -196,6 +216,6 @@ def _parse(text: str | None) -> dict[str, Any] | None:
         return None
     try:
         data = json.loads(text)
-    except ValueError:
+    except (ValueError, RecursionError):
         return None
     return data if isinstance(data, dict) else None

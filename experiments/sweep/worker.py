@@ -17,6 +17,7 @@ from __future__ import annotations
 import atexit
 import contextlib
 import json
+import math
 import os
 import select
 import signal
@@ -30,6 +31,9 @@ from pathlib import Path
 
 from experiments.sweep.child import PARENT_ENV
 from experiments.sweep.episode import Episode
+from maps.located import validate
+from maps.store import InputError
+from missions.model import RunArguments
 
 OUTPUT_TAIL = 4000
 """Characters of an episode's terminal output kept when it fails without a report."""
@@ -96,6 +100,19 @@ START_METHODS = ("fork", "spawn")
 """``fork``: episodes are forked from a warm server that has imported the run command (see
 :mod:`experiments.sweep.server`); ``spawn``: each episode is a fresh interpreter. Either way each
 episode is its own process; ``fork`` saves the ~0.3 s of imports per episode."""
+
+
+def run_number_problem(max_time_s: float | None, timeout_s: float | None) -> str | None:
+    """Why a sweep's ``--max-time`` (checked as ``bearings run`` checks it, so no episode can refuse
+    it after the pre-flight) or ``--timeout`` (finite, positive wall seconds) is refused, or None."""
+    if max_time_s is not None:
+        try:
+            validate(RunArguments, {"--max-time": max_time_s}, file="--max-time")
+        except InputError as exc:
+            return str(exc.diagnostics[0].message)
+    if timeout_s is not None and not (math.isfinite(timeout_s) and timeout_s > 0):
+        return f"--timeout must be a finite number of seconds above 0, got {timeout_s:g}"
+    return None
 
 
 def run_episode(episode: Episode, timeout_s: float | None = None, stop: StopToken | None = None,

@@ -61,23 +61,40 @@ def readonly(array: np.ndarray) -> np.ndarray:
 
 def preorder(parent: np.ndarray, alive: np.ndarray, ends: Sequence[int]) -> list[int]:
     """The alive nodes in preorder, children ordered by the first viewframe below them (``ends``:
-    each viewframe's last node): the canonical node order of a map's arrays."""
-    first = np.full(len(parent), len(ends), dtype=np.int64)
+    each viewframe's last node): the canonical node order of a map's arrays. Linear in the nodes
+    (the first viewframe below a node is carried up from the leaves in one pass)."""
+    up = np.asarray(parent).tolist()
+    below = [len(ends)] * len(up)
     for k in range(len(ends) - 1, -1, -1):
-        n = ends[k]
-        while n >= 0:
-            first[n] = k
-            n = parent[n]
+        below[ends[k]] = k
+    for n in reversed(top_down(up)):  # children before their parents
+        if up[n] >= 0 and below[n] < below[up[n]]:
+            below[up[n]] = below[n]
     children: dict[int, list[int]] = {}
     roots: list[int] = []
     for n in np.flatnonzero(alive).tolist():
-        (roots if parent[n] < 0 else children.setdefault(int(parent[n]), [])).append(n)
+        (roots if up[n] < 0 else children.setdefault(up[n], [])).append(n)
     order: list[int] = []
-    stack = sorted(roots, key=lambda n: -int(first[n]))
+    stack = sorted(roots, key=lambda n: -below[n])
     while stack:
         node = stack.pop()
         order.append(node)
-        stack.extend(sorted(children.get(node, ()), key=lambda c: -int(first[c])))
+        stack.extend(sorted(children.get(node, ()), key=lambda c: -below[c]))
+    return order
+
+
+def top_down(parent: Sequence[int] | np.ndarray) -> list[int]:
+    """Every node, each after its parent (the learner adds a new root after the old one, so the
+    numbering need not be such an order): one pass over the nodes, whatever the tree's height."""
+    children: list[list[int]] = [[] for _ in range(len(parent))]
+    roots: list[int] = []
+    for n, p in enumerate(np.asarray(parent).tolist()):
+        (roots if p < 0 else children[p]).append(n)
+    order, stack = [], roots[::-1]
+    while stack:
+        n = stack.pop()
+        order.append(n)
+        stack.extend(children[n])
     return order
 
 

@@ -66,7 +66,16 @@ from maps.ltmap.arrays import (
     readonly,
 )
 from maps.ltmap.matching import Viewframe, ViewframeCache, match_viewframe, stack_viewframe
-from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS, PruneReport, PruneStep, cut_lowest_level, follow
+from maps.ltmap.prune import (
+    DEFAULT_MIN_LANDMARKS,
+    LevelCut,
+    PruneReport,
+    PruneStep,
+    cut_lowest_level,
+    cut_quiet_levels,
+    follow,
+    quiet_levels,
+)
 from perception.matching import LandmarkMatches
 from perception.observation import Observation
 from perception.similarity import bearing_angles
@@ -400,14 +409,29 @@ class LandmarkTree:
             raise ValueError(f"min_landmarks must be >= 0, got {min_landmarks}")
         if self.height == 0:
             return None
+        return self._apply(cut_lowest_level(self._parent, self._leaves, self._rows.node, min_landmarks), 1)
+
+    def _prune_quiet_levels(self, budget_bytes: int, min_landmarks: int) -> PruneStep | None:
+        """Cut at once the levels whose one-by-one cuts change only the chains at the bottom
+        (:func:`maps.ltmap.prune.quiet_levels`): the same map as :meth:`prune_level` repeated, in
+        one pass; None when fewer than two levels are quiet."""
+        data = self._rows.data
+        row = 3 * np.dtype(BEARING_DTYPE).itemsize + int(np.prod(data.shape[1:], dtype=np.int64)) * data.itemsize
+        levels, chains = quiet_levels(self._parent, self._leaves, self._rows.node, min_landmarks,
+                                      excess_bytes=self.memory_bytes() - budget_bytes, row_bytes=row,
+                                      node_bytes=NODE_BYTES)
+        if levels < 2:
+            return None
+        return self._apply(cut_quiet_levels(self._parent, self._leaves, self._rows.node, chains, levels), levels)
+
+    def _apply(self, cut: LevelCut, levels: int) -> PruneStep:
         before = (self.height, self.memory_bytes(), self.landmark_count)
-        cut = cut_lowest_level(self._parent, self._leaves, self._rows.node, min_landmarks)
         self._parent, self._leaves = cut.node_parent, cut.viewframe_leaves
         self._rows = self._rows.take(cut.keep)
         self._rows.node = cut.landmark_nodes
         self._cache.clear()
         return PruneStep(before[0], self.height, before[1], self.memory_bytes(), before[2] - self.landmark_count,
-                         cut.merged, cut.deleted, cut.landmark_index, cut.viewframe_index)
+                         cut.merged, cut.deleted, cut.landmark_index, cut.viewframe_index, levels)
 
     def prune_to(self, budget_bytes: int, min_landmarks: int = DEFAULT_MIN_LANDMARKS) -> PruneReport:
         """Cut levels until :meth:`memory_bytes` <= ``budget_bytes``; the map is unchanged when it cannot."""
@@ -417,7 +441,7 @@ class LandmarkTree:
         work, steps = self.copy(), list[PruneStep]()
         index, viewframes = np.arange(self.landmark_count), np.arange(self.viewframe_count)
         while work.memory_bytes() > budget_bytes:
-            step = work.prune_level(min_landmarks)
+            step = work._prune_quiet_levels(budget_bytes, min_landmarks) or work.prune_level(min_landmarks)
             if step is None:
                 return PruneReport(budget_bytes, False, before, before, work.memory_bytes(), tuple(steps),
                                    np.arange(self.landmark_count), np.arange(self.viewframe_count))

@@ -8,13 +8,14 @@ the camera YAML (``perception.camera.camera_from_dict`` reads it back) atomicall
 from __future__ import annotations
 
 import argparse
+import os
 import re
 from pathlib import Path
 
 import cv2
 
 from maps.store import write_yaml
-from missions.commands.common import fail
+from missions.commands.common import fail, same_as_input
 from perception.calibration import (
     BOARD_CORNERS,
     SQUARE_M,
@@ -100,6 +101,9 @@ def run(args: argparse.Namespace) -> int:
     except ValueError:
         low, high = SQUARE_M
         return fail("calibrate", f"--square must be {low:g} to {high:g} m (the side of one square), got {args.square}")
+    problem = same_as_input(args.output, args.images)
+    if problem:
+        return fail("calibrate", f"cannot write {args.output}: {problem}")
     images = []
     for name in args.images:
         if not Path(name).is_file():
@@ -131,12 +135,13 @@ def run(args: argparse.Namespace) -> int:
             "images_repeated": [{"image": names[j], "same_pose_as": names[i]} for j, i in result.repeated],
         },
     }
+    replacing = os.path.isfile(args.output)
     try:
         write_yaml(args.output, data, header="camera calibration written by 'bearings calibrate'")
     except OSError as exc:
         return fail("calibrate", f"{args.output}: cannot write: {exc.strerror or exc}")
     _print_summary(result, names, len(images))
-    print(f"wrote {args.output}")
+    print(f"wrote {args.output}" + (" (replaced the previous file)" if replacing else ""))
     return 0
 
 

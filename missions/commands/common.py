@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import os
 import sys
+from collections.abc import Iterable
 from pathlib import Path
 
 from drivers.sim.world_file import MAX_COORD
@@ -19,6 +22,10 @@ EXIT_OK, EXIT_FAILURE, EXIT_INVALID = 0, 1, 2
 def add_mission_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
                         help="override a mission input (repeatable); the value is parsed as YAML (2, true, abc)")
+    parser.add_argument("--output-dir", type=Path, metavar="DIR",
+                        help="where the mission's files go (maps it saves): relative paths resolve here, and a "
+                             "file outside DIR and the mission's folder is refused (default: the mission's "
+                             "folder; the current one for a shipped mission)")
     parser.add_argument("--path", dest="search_path", action="append", default=[], metavar="DIR",
                         help="extra folder where 'include:' looks for mission files (repeatable; "
                              "also $BEARINGS_PATH)")
@@ -40,7 +47,8 @@ def parse_sets(sets: list[str]) -> dict[str, str]:
 
 
 def load_from_args(path: str, args: argparse.Namespace) -> MissionSpec:
-    return load_mission(path, overrides=parse_sets(args.sets), search_path=args.search_path)
+    return load_mission(path, overrides=parse_sets(args.sets), search_path=args.search_path,
+                        output_dir=getattr(args, "output_dir", None))
 
 
 def print_input_error(exc: InputError) -> int:
@@ -81,14 +89,34 @@ def parse_pose(text: str, named: dict[str, Pose2D], *, option: str) -> Pose2D:
     return Pose2D(x, y, theta)
 
 
-def emit(command: str, text: str, output: Path | None) -> int:
-    """Write a command's result to ``output`` (atomically) or to stdout; exit 2 with the reason when
-    ``output`` cannot be written."""
+def emit(command: str, text: str, output: str | os.PathLike | None, inputs: Iterable[str | os.PathLike] = ()) -> int:
+    """Write a command's result to ``output`` (atomically) or to stdout. Exit 2 with the reason when
+    ``output`` cannot be written or is one of the command's ``inputs`` (``import t.xml -o t.xml``
+    would replace the tree by the mission); a file replaced is named on stderr; a write that fails
+    (a full disk) is one line and exit 1, the previous file kept whole."""
     if output is None:
         sys.stdout.write(text)
         return EXIT_OK
-    problem = output_problem(output)
+    problem = output_problem(output) or same_as_input(output, inputs)
     if problem:
         return fail(command, f"cannot write {output}: {problem}")
-    write_text_atomic(output, text)
+    replacing = os.path.isfile(output)
+    try:
+        write_text_atomic(output, text)
+    except OSError as exc:
+        print(f"bearings {command}: cannot write {output}: {exc.strerror or exc} (nothing was changed)",
+              file=sys.stderr)
+        return EXIT_FAILURE
+    if replacing:
+        print(f"bearings {command}: replaced {output}", file=sys.stderr)
     return EXIT_OK
+
+
+def same_as_input(output: str | os.PathLike, inputs: Iterable[str | os.PathLike]) -> str | None:
+    """Why ``output`` must not be written: it is (a link to) one of the command's input files
+    (``import t.xml -o t.xml``, ``calibrate a.png -o a.png``), else None."""
+    for given in inputs:
+        with contextlib.suppress(OSError):
+            if os.path.exists(output) and os.path.samefile(output, given):
+                return f"it is the input file {given}: write the result elsewhere"
+    return None

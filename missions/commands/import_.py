@@ -31,4 +31,4 @@ def run(args: argparse.Namespace) -> int:
         text = import_btcpp(args.tree)
     except InputError as exc:
         return print_input_error(exc)
-    return emit("import", text, args.output)
+    return emit("import", text, args.output, inputs=[args.tree])

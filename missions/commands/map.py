@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import re
 
 from maps.ltmap.file import load_ltmap, save_ltmap
@@ -129,6 +130,7 @@ def run_prune(args: argparse.Namespace) -> int:
     if not report.fits:
         return fail("map", f"{args.file}: cannot prune to {budget} bytes: with one level left the map still "
                            f"takes {report.smallest_bytes} bytes")
+    replacing = os.path.isfile(args.output)
     try:
         save_ltmap(args.output, tree)
     except OSError as exc:
@@ -136,5 +138,6 @@ def run_prune(args: argparse.Namespace) -> int:
     after = tree.summary()
     print(f"{args.file}: {before.memory_bytes} -> {after.memory_bytes} bytes (budget {budget}), "
           f"{report.levels_cut} level(s) cut, height {before.height} -> {after.height}, "
-          f"viewframes {before.viewframes} -> {after.viewframes}; wrote {args.output}")
+          f"viewframes {before.viewframes} -> {after.viewframes}; wrote {args.output}"
+          + (" (replaced the previous file)" if replacing else ""))
     return EXIT_OK

@@ -15,6 +15,7 @@ from maps.store import Diagnostic, InputError, output_problem, write_json
 from missions.clocks import Paced, WallClock
 from missions.commands.common import add_mission_options, load_from_args, parse_pose, print_input_error
 from missions.model import RunArguments
+from missions.outputs import prepare_written_files
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
 from perception.collision_monitor import MonitorConfig
@@ -74,9 +75,12 @@ def run(args: argparse.Namespace) -> int:
             numbers = _numbers(args)
             _prepare_outputs(args)
             mission = load_from_args(args.mission, args)
+            prepare_written_files(mission, lambda note: print(f"bearings run: {note}", file=sys.stderr))
             simulation, robot, clock, safety = _open(args, numbers.seed)
         except InputError as exc:
             return print_input_error(exc)
+        except DeviceUnavailable as exc:
+            return _device_fault(args, exc)
         except Interrupted as exc:
             return _interrupted_early(args, exc.signum)
         try:
@@ -154,6 +158,20 @@ def _prepare_outputs(args: argparse.Namespace) -> None:
         raise InputError(problems)
 
 
+class DeviceUnavailable(Exception):  # noqa: N818 - a state of the robot, as DriverFault
+    """A device of the robot could not be opened or did not answer: a fault of the machine, not of
+    the input (exit 1 with a report, as ``doctor`` says 1), the profile itself being valid."""
+
+
+def _device_fault(args: argparse.Namespace, exc: DeviceUnavailable) -> int:
+    reason = f"device fault: {exc}"
+    print(f"{args.mission}: FAILURE ({reason})", file=sys.stderr)
+    if args.report and not output_problem(args.report):
+        write_json(args.report, {"mission": str(args.mission), "status": "FAILURE", "reason": reason,
+                                 "ticks": 0, "wall_time_s": 0.0, "last_command": {"v": 0.0, "w": 0.0}})
+    return 1
+
+
 def _interrupted_early(args: argparse.Namespace, signum: int) -> int:
     reason = "interrupted before the mission started"
     print(f"{args.mission}: INTERRUPTED ({reason})", file=sys.stderr)
@@ -174,8 +192,8 @@ def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock, M
         clock = WallClock()  # one time axis for the drivers' stamps and the tree
         try:
             robot = open_robot(args.robot, clock=clock.now)
-        except OSError as exc:
-            raise InputError([Diagnostic(args.robot, 0, 0, f"cannot open the robot: {exc}")]) from None
+        except OSError as exc:  # a valid profile whose robot does not answer: a device fault, not bad input
+            raise DeviceUnavailable(f"cannot open the robot of {args.robot}: {exc}") from None
         try:
             return None, robot, clock, robot_safety(args.robot, robot)
         except InputError:

@@ -30,4 +30,4 @@ def run(args: argparse.Namespace) -> int:
         text = FORMATS[args.format](mission)  # the XML export refuses what BT.CPP cannot express
     except InputError as exc:
         return print_input_error(exc)
-    return emit("show", text, args.output)
+    return emit("show", text, args.output, inputs=mission.files)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from pathlib import Path
 
 import cv2
@@ -104,11 +105,13 @@ def run_snapshot(args: argparse.Namespace) -> int:
         ok = False
     if not ok:
         return fail("sim", f"cannot encode an image as {suffix!r}: use .png (or another format OpenCV writes)")
+    replacing = os.path.isfile(args.output)
     try:
         write_bytes_atomic(args.output, encoded.tobytes())
     except OSError as exc:
         return fail("sim", f"cannot write {args.output}: {exc.strerror or exc}")
-    print(f"wrote {args.output} ({image.shape[1]} x {image.shape[0]}, camera {args.camera!r} of {sim.name!r})")
+    print(f"wrote {args.output} ({image.shape[1]} x {image.shape[0]}, camera {args.camera!r} of {sim.name!r})"
+          + (", replaced the previous file" if replacing else ""))
     return EXIT_OK
 
 

@@ -6,6 +6,7 @@ import json
 
 import pytest
 
+from drivers.sim.world_file import LEVEL_PANORAMA_BYTES_PER_PIXEL, RENDER_BYTES_PER_PIXEL
 from experiments.bench import sim as bench_sim
 
 
@@ -19,3 +20,10 @@ def test_bench_reports_named_json_figures() -> None:
     assert figures["panorama_cost_ratio_lab"] == pytest.approx(
         1e3 / figures["panoramas_per_s_lab"] / figures["remap_reference_ms"], rel=0.01
     )
+    # the world loader budgets cameras with fixed figures (a world is valid or not on any machine):
+    # they must cover the renderer's measured peak memory per pixel (a memory figure, not a time)
+    measured = figures["render_bytes_per_pixel"]
+    assert 300 < measured["pinhole"] <= RENDER_BYTES_PER_PIXEL
+    assert 0 < measured["level_panorama"] <= LEVEL_PANORAMA_BYTES_PER_PIXEL
+    assert figures["render_bytes_per_pixel_budgeted"] == {"pinhole": RENDER_BYTES_PER_PIXEL,
+                                                          "level_panorama": LEVEL_PANORAMA_BYTES_PER_PIXEL}

@@ -192,7 +192,9 @@ def test_journal_writes_whole_lines_and_cuts_a_torn_tail(tmp_path):
     (["--sim", "lab,nowhere"], "nowhere: no such world file or shipped world"),
     (["--set", "side=abc"], "input 'side' expects a number"),
     (["--set", "colour=red"], "unknown input 'colour'"),
-    (["--timeout", "0"], "--timeout must be positive"),
+    (["--timeout", "0"], "--timeout must be a finite number of seconds above 0, got 0"),
+    (["--max-time", "inf"], "--max-time expects a finite number in s, got inf"),
+    (["--seeds", "1-" + "9" * 5000], "--seeds: seeds go from 0 to 4294967295"),
 ])
 def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys, args, message):
     assert sweep(*SQUARE, *args, "--workers", "1", "-o", str(tmp_path / "out")) == 2

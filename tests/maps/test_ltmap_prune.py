@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from maps.ltmap.arrays import IDS
 from maps.ltmap.prune import cut_lowest_level, follow
 from maps.ltmap.tree import LandmarkTree
-from tests.maps.ltmap_trees import Rows
+from tests.maps.ltmap_trees import Rows, same_arrays
 
 SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
@@ -89,3 +89,55 @@ def test_memory_never_grows_under_pruning_and_reaches_height_zero(seed, views):
     assert tree.height == 0 and len(sizes) - 1 <= views
 
 
+
+
+def _comb(rng: np.random.Generator) -> LandmarkTree:
+    """A random top tree with chains of single-child nodes under its leaves, some nodes empty: the
+    shape whose levels are cut several at once."""
+    parent, level = [-1], [0]
+    for _ in range(int(rng.integers(1, 4))):
+        below = []
+        for above in level:
+            for _ in range(int(rng.integers(1, 3))):
+                parent.append(above)
+                below.append(len(parent) - 1)
+        level = below
+    leaves = []
+    for top in level:
+        for _ in range(int(rng.integers(0, 10))):
+            parent.append(top)
+            top = len(parent) - 1
+        leaves.append(top)
+    depth = [0] * len(parent)
+    for n in range(1, len(parent)):
+        depth[n] = depth[parent[n]] + 1
+    deepest = max(depth[leaf] for leaf in leaves)
+    for k, leaf in enumerate(leaves):  # every leaf at the same depth
+        while depth[leaf] < deepest:
+            parent.append(leaf)
+            depth.append(depth[leaf] + 1)
+            leaf = len(parent) - 1
+        leaves[k] = leaf
+    size = (rng.random(len(parent)) < rng.random()) * rng.integers(0, 5, size=len(parent))
+    bearings = np.zeros((int(size.sum()), 3), np.float32)
+    bearings[:, 0] = 1
+    return LandmarkTree.from_arrays({"ids": np.arange(len(bearings), dtype=np.int64), "bearings": bearings,
+                                     "node_parent": np.array(parent, np.int32), "node_size": size.astype(np.int32),
+                                     "viewframe_leaf": np.array(leaves, np.int32)}, kind=IDS)
+
+
+@SETTINGS
+@given(st.integers(0, 2**32 - 1))
+def test_levels_cut_at_once_give_what_cutting_them_one_by_one_gives(seed):
+    rng = np.random.default_rng(seed)
+    tree = _comb(rng)
+    min_landmarks, budget = int(rng.integers(0, 12)), int(rng.integers(0, tree.memory_bytes() + 1))
+    one_by_one, index, views, cuts = tree.copy(), np.arange(tree.landmark_count), np.arange(tree.viewframe_count), 0
+    while one_by_one.memory_bytes() > budget and (step := one_by_one.prune_level(min_landmarks)) is not None:
+        index, views, cuts = follow(index, step.landmark_index), follow(views, step.viewframe_index), cuts + 1
+    report = tree.prune_to(budget, min_landmarks)
+    assert report.fits == (one_by_one.memory_bytes() <= budget)
+    if report.fits:
+        assert report.levels_cut == cuts and report.bytes_after == one_by_one.memory_bytes()
+        assert same_arrays(tree.to_arrays(), one_by_one.to_arrays())
+        assert np.array_equal(report.landmark_index, index) and np.array_equal(report.viewframe_index, views)

@@ -33,7 +33,7 @@ def test_teach_and_repeat_with_the_ideal_sensor_returns_home(tmp_path):
     path, report = tmp_path / "route.ltmap", tmp_path / "report.json"
     code = main(["run", "teach_and_repeat", "--sim", "lab", "--seed", "4", "--quiet", "--report", str(report),
                  "--set", "camera=landmarks", "--set", f"map={path}", "--set", "route=[1.6, 0.0]",
-                 "--set", "min_landmarks=8"])
+                 "--set", "min_landmarks=8", "--output-dir", str(tmp_path)])
     data = json.loads(report.read_text())
     assert code == 0, data["reason"]
     section = data["ltmap"]
@@ -49,6 +49,7 @@ def test_teach_and_repeat_with_the_ideal_sensor_returns_home(tmp_path):
 def test_teach_route_by_keyboard_needs_a_terminal(tmp_path):
     report = tmp_path / "report.json"
     code = main(["run", "teach_route", "--sim", "lab", "--quiet", "--report", str(report), "--max-time", "5",
-                 "--set", "camera=landmarks", "--set", "drive=keyboard", "--set", f"map={tmp_path / 'r.ltmap'}"])
+                 "--set", "camera=landmarks", "--set", "drive=keyboard", "--set", f"map={tmp_path / 'r.ltmap'}",
+                 "--output-dir", str(tmp_path)])
     data = json.loads(report.read_text())
     assert code == 1 and "terminal" in data["reason"] and not (tmp_path / "r.ltmap").exists()

@@ -18,9 +18,9 @@ def test_shipped_profiles_are_valid_and_need_their_hardware(path, capsys):
     name, devices = load_profile(path)
     assert devices[0].role == "base" and devices[0].driver == "pioneer"
     assert all(d.settings.name == d.name for d in devices if d.role == "camera")  # frames carry the profile's name
-    assert main(["run", "square", "--robot", str(path), "--quiet"]) == 2  # no robot on this machine
+    assert main(["run", "square", "--robot", str(path), "--quiet"]) == 1  # no robot here: a device fault
     err = capsys.readouterr().err
-    assert "cannot open the robot:" in err and "Traceback" not in err
+    assert f"FAILURE (device fault: cannot open the robot of {path}:" in err and "Traceback" not in err
 
 
 def test_driver_settings_errors_are_located_in_the_profile(tmp_path):

@@ -111,7 +111,7 @@ def test_learn_targets_then_goto_target_in_a_small_room(tmp_path, world_file):
     folder = write_target_images(world, ["a", "b"], tmp_path / "targets")
     roadmap, report = tmp_path / "small.roadmap", tmp_path / "learn.json"
     code = run("run", "learn_targets", "--sim", str(world), "--quiet", "--report", str(report),
-               "--set", f"targets={folder}", "--set", f"roadmap={roadmap}")
+               "--set", f"targets={folder}", "--set", f"roadmap={roadmap}", "--output-dir", str(tmp_path))
     data = json.loads(report.read_text())
     assert code == 0, data["reason"]
     section = data["roadmap"]

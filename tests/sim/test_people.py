@@ -14,6 +14,7 @@ from drivers.sim.world import load_world
 from drivers.sim.world_values import Person, TextureSpec
 from maps.store import InputError
 from perception.geometry import Pose2D
+from tests.sim.conftest import drive_for
 
 TEXTURE = TextureSpec(seed=1)
 HALL = """
@@ -61,9 +62,7 @@ def test_a_walking_person_waits_for_the_robot_then_walks_on(sim_from):
         sim.step(0.1)
     x = sim.people_xy()[0, 0]
     assert 0.25 + 0.25 + PERSONAL_SPACE_M - 1e-9 <= x <= 0.25 + 0.25 + PERSONAL_SPACE_M + 0.1  # stopped in front
-    sim.robot.base.drive(0.5, 0.0)  # the robot drives out of the way (+y)
-    for _ in range(30):
-        sim.step(0.1)
+    drive_for(sim, 0.5, 0.0, 3.0)  # the robot drives out of the way (+y)
     assert sim.people_xy()[0, 0] < -0.5  # walked on, past where the robot stood
     report = sim.ground_truth_report()
     assert report["collisions"] == 0
@@ -72,9 +71,7 @@ def test_a_walking_person_waits_for_the_robot_then_walks_on(sim_from):
 
 def test_driving_into_a_standing_person_is_a_collision_with_a_person(sim_from):
     sim = sim_from(HALL + "people: [{path: [[1.5, 0]], radius: 0.3}]\n")
-    sim.robot.base.drive(0.4, 0.0)
-    for _ in range(60):
-        sim.step(0.1)
+    drive_for(sim, 0.4, 0.0, 6.0)
     assert sim.robot.base.stalled()
     assert sim.true_pose().x == pytest.approx(1.5 - 0.3 - 0.25, abs=0.001)  # stopped at contact
     report = sim.ground_truth_report()

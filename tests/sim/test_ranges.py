@@ -10,6 +10,7 @@ import pytest
 
 from drivers.interfaces import RangeSource
 from drivers.sim.ranges import FIRING_PERIOD_S
+from tests.sim.conftest import drive_for
 
 WALL_AHEAD = """
 start: {x: 0, y: 0, theta_deg: 0}
@@ -102,16 +103,14 @@ def test_missed_echoes_come_at_the_set_rate(sim_from):
 
 def test_the_front_bumper_presses_on_contact_ahead_and_the_rear_one_behind(sim_from):
     sim = sim_from(ROOM)
-    sim.robot.base.drive(0.3, 0.0)
-    settle(sim, 6.0)
+    drive_for(sim, 0.3, 0.0, 6.0)
     assert sim.robot.base.stalled()
     scan = sim.robot.ranges.read()
     assert scan.bumped(+1) and not scan.bumped(-1)
     assert scan.pressed.tolist().index(True) == 2  # the middle front segment, straight ahead
-    sim.robot.base.drive(-0.3, 0.0)
-    settle(sim, 0.5)
+    drive_for(sim, -0.3, 0.0, 0.5)
     assert not sim.robot.ranges.read().pressed.any()  # backed off: released
-    settle(sim, 12.0)  # on into the wall behind
+    drive_for(sim, -0.3, 0.0, 12.0)  # on into the wall behind
     scan = sim.robot.ranges.read()
     assert scan.bumped(-1) and not scan.bumped(+1)
     assert scan.pressed.tolist().index(True) == 7  # the middle rear segment, straight behind
@@ -119,8 +118,7 @@ def test_the_front_bumper_presses_on_contact_ahead_and_the_rear_one_behind(sim_f
 
 def test_a_person_presses_the_bumper_too(sim_from):
     sim = sim_from(WALL_AHEAD + "people: [{path: [[1.2, 0.3]], radius: 0.3}]\n")
-    sim.robot.base.drive(0.3, 0.0)
-    settle(sim, 6.0)
+    drive_for(sim, 0.3, 0.0, 6.0)
     scan = sim.robot.ranges.read()
     # the person's centre is left of the heading: the contact point is at about 30 deg left
     assert scan.pressed.tolist().index(True) == 1
@@ -131,16 +129,14 @@ def test_min_clearance_against_a_hand_placed_wall(sim_from):
     sim = sim_from(WALL_AHEAD)
     settle(sim, 1.0)  # standing: the disc is 2 - 0.25 m from the wall
     assert sim.ground_truth_report()["min_clearance_m"] == pytest.approx(1.75)
-    sim.robot.base.drive(0.5, 0.0)
-    settle(sim, 2.0)  # on towards the wall
+    drive_for(sim, 0.5, 0.0, 2.0)  # on towards the wall
     x = sim.true_pose().x
     assert sim.ground_truth_report()["min_clearance_m"] == pytest.approx(2.0 - 0.25 - x)
-    settle(sim, 6.0)
+    drive_for(sim, 0.5, 0.0, 6.0)
     report = sim.ground_truth_report()
     assert report["collisions"] == 1 and report["collisions_with_people"] == 0
     assert 0.0 <= report["min_clearance_m"] <= 0.001  # stopped at contact
-    sim.robot.base.drive(-0.5, 0.0)
-    settle(sim, 2.0)
+    drive_for(sim, -0.5, 0.0, 2.0)
     assert sim.ground_truth_report()["min_clearance_m"] == report["min_clearance_m"]  # the smallest over the run
 
 

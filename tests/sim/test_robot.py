@@ -21,8 +21,8 @@ cameras: [{name: eye, kind: bearings}]
 
 
 def drive(sim, v: float, w: float, seconds: float, dt: float = 0.05) -> None:
-    sim.robot.base.drive(v, w)
     for _ in range(round(seconds / dt)):
+        sim.robot.base.drive(v, w)  # commanded every step, as a client does (the base's watchdog)
         sim.step(dt)
 
 
@@ -175,3 +175,18 @@ def test_the_report_holds_every_stop_exactly_where_the_trajectory_is_decimated(s
     assert 1.0 < t0 < 2.0 and t1 == pytest.approx(t_still, abs=0.051)  # the turn starts at once
     assert (x, y, theta) == pytest.approx((still.x, still.y, still.theta), abs=1e-4)
     assert stops[-1][1] == pytest.approx(sim.time) and len(stops) == 2  # and standing at the end
+
+
+def test_a_base_left_without_commands_stops_as_the_robots_firmware_stops_it(sim_from) -> None:
+    """The firmware's watchdog rule (docs/protocols.md): no command for 2 s, the base stops."""
+    sim = sim_from(ROOM)
+    sim.robot.base.drive(0.3, 0.0)  # once, and never again
+    for _ in range(round(1.9 / 0.05)):
+        sim.step(0.05)
+    assert sim.drive.target == (0.3, 0.0) and sim.drive.velocity[0] > 0.29
+    for _ in range(round(0.2 / 0.05)):
+        sim.step(0.05)
+    assert sim.drive.target == (0.0, 0.0)  # 2 s without a command: stopping (at the deceleration limit)
+    for _ in range(round(2.0 / 0.05)):
+        sim.step(0.05)
+    assert sim.drive.velocity == (0.0, 0.0)
