@@ -5,21 +5,27 @@ base gets instead, from the obstacle points around the base (:mod:`maps.avoidanc
 the robot's odometry. Three phases:
 
 - **clear**: the wish passes unchanged. A forward wish whose arc is not free for as far as it
-  means to go (:func:`maps.avoidance.arcs.needed_distance`), or one the collision monitor
+  means to go (:func:`maps.avoidance.sweep.needed_distance`), or one the collision monitor
   stopped, holds the robot: it waits.
 - **waiting**: stopped, so that a person walking across can pass (a blocked way that changes by
   itself costs no detour). The way clearing ends the wait; a way blocked again within
   ``clear_time`` resumes the same wait (the clock keeps running). After ``wait`` seconds still
-  blocked, a detour starts when an arc will do (:func:`maps.avoidance.arcs.choose`, kept within
-  ``max_stray`` of the line the robot was on when it was first held).
-- **detour**: the chosen arc at the detour's speed, every tick chosen again, on the side the
-  detour took. Once the wish's own arc is free again (for the detour's distance, a hysteresis)
-  the wish passes; ``clear_time`` of that ends the detour, and the motion node steers back to its
-  path by itself. No arc will do: stopped (a turn on the spot the wish asks for still passes).
+  blocked, a detour starts when a direction will do (:func:`maps.avoidance.directions.choose`,
+  kept within ``max_stray`` of the line the robot was on when it was first held).
+- **detour**: every tick the free direction closest to the wish, on the side the detour took,
+  steered to (:func:`maps.avoidance.directions.steer`: an arc, or a turn on the spot first).
+  Once a forward wish's own arc is free again (as far as the detour needs, a hysteresis) the
+  wish passes; ``clear_time`` of that ends the detour, and the motion node steers back to its
+  path by itself. A wish to stop or to back away passes (the collision monitor judges it). Where
+  the wish heads is kept in the odometry frame from its last forward command, so that a wish to
+  turn on the spot (which says only which way) does not swing the choice as the robot turns. No
+  direction will do: stopped.
 
 Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
-without an arc, for ``timeout`` seconds ("blocked for 20 s by an obstacle 0.40 m ahead"), or a
-detour longer than ``max_length`` metres that has not got past.
+without a direction, for ``timeout`` seconds ("blocked for 20 s by an obstacle 0.40 m ahead"), a
+detour longer than ``max_length`` metres that has not got past, or one that has turned by
+:data:`GOING_ROUND` (180 degrees): it is going round the obstacle, because what the motion node
+heads for is behind it or in it (a person standing where a viewframe was taught).
 
 Pure: no clock of its own (``now`` is passed in), no I/O; the tallies (:class:`Tally`) are what
 the run report's ``avoidance`` section shows.
@@ -33,20 +39,13 @@ from typing import Literal
 
 import numpy as np
 
-from maps.avoidance.arcs import (
-    ArcSettings,
-    Choice,
-    DetourLine,
-    Surroundings,
-    choose,
-    free_distance,
-    needed_distance,
-    wished_curvature,
-)
-from perception.geometry import Pose2D
+from maps.avoidance.directions import Choice, choose, steer, wished_direction
+from maps.avoidance.sweep import AvoidSettings, DetourLine, Surroundings, free_distance, needed_distance
+from perception.geometry import Pose2D, wrap_angle
 from perception.polygons import distance
 
 Phase = Literal["clear", "waiting", "detour"]
+GOING_ROUND = math.pi  # rad: a detour that has turned this much is going round the obstacle, not past it
 
 
 @dataclass(frozen=True, slots=True)
@@ -54,7 +53,7 @@ class DetourSettings:
     """How long to wait, when to give up (module docstring)."""
 
     wait: float = 2.0  # s held before a detour is tried
-    timeout: float = 20.0  # s held (waiting, or on a detour with no arc) before giving up
+    timeout: float = 20.0  # s held (waiting, or on a detour with no direction) before giving up
     clear_time: float = 1.0  # s the way must stay clear to end a wait or a detour
     max_length: float = 6.0  # m: a detour this long that has not got past gives up
 
@@ -94,18 +93,20 @@ class _Episode:
     line: DetourLine
     detour_start: float | None = None
     length: float = 0.0
+    turned: float = 0.0  # rad, signed: the heading's change since the detour started
     last: Pose2D | None = None
     side: int = 0
+    goal: float | None = None  # rad, odometry: where the wish heads, from its last forward command
     clear_since: float | None = None  # the way clear since (the wish passing again)
-    held_since: float | None = None  # on a detour with no arc (or stopped by the monitor) since
+    held_since: float | None = None  # on a detour with no direction (or stopped by the monitor) since
     by_monitor: bool = False  # held because the collision monitor stopped a wish the arcs found free
 
 
 class Avoidance:
     """Decides each tick's command for one motion node's wishes (module docstring)."""
 
-    def __init__(self, arcs: ArcSettings, settings: DetourSettings | None = None) -> None:
-        self.arcs = arcs
+    def __init__(self, avoid: AvoidSettings, settings: DetourSettings | None = None) -> None:
+        self.avoid = avoid
         self.settings = settings or DetourSettings()
         self.tally = Tally()
         self.phase: Phase = "clear"
@@ -120,7 +121,7 @@ class Avoidance:
              stopped: bool = False) -> Decision:
         """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
         robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command."""
-        around = Surroundings.of(points, self.arcs)
+        around = Surroundings.of(points, self.avoid)
         episode = self._episode
         if episode is not None and episode.detour_start is not None:
             return self._detour(episode, v, w, around, pose, now, stopped)
@@ -170,15 +171,16 @@ class Avoidance:
         held = now - episode.since
         if held < self.settings.wait:
             return Decision(0.0, 0.0, "waiting")
-        choice = choose(around, wished_curvature(v, w, self.arcs), self.arcs, reach=self._reach(v), pose=pose,
+        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v), pose=pose,
                         line=episode.line)
-        if choice.arc is not None:
+        if choice.direction is not None:
             self._end_wait(episode, now, cleared=False)
             episode.detour_start, episode.last, episode.side = now, pose, choice.side
             self.phase = "detour"
             self.tally.detours += 1
             side = {1: "left", -1: "right"}.get(choice.side, "ahead")
-            return Decision(*self._arc(choice), "detour", choice, f"detour to the {side} after {held:.1f} s")
+            return Decision(*steer(choice, around, self.avoid), "detour", choice,
+                            f"detour to the {side} after {held:.1f} s")
         if held >= self.settings.timeout:
             return self._give_up(self._blocked_reason(held, v, w, around.points, choice), now)
         return Decision(0.0, 0.0, "waiting", choice)
@@ -187,11 +189,18 @@ class Avoidance:
                 stopped: bool) -> Decision:
         if episode.last is not None:
             episode.length += math.hypot(pose.x - episode.last.x, pose.y - episode.last.y)
+            episode.turned += wrap_angle(pose.theta - episode.last.theta)
         episode.last = pose
         if episode.length > self.settings.max_length:
             return self._give_up(f"a detour of {episode.length:.1f} m did not get past the obstacle "
                                  f"(at most {self.settings.max_length:g} m)", now)
-        if not stopped and not self._blocked(v, w, around, at_least=self._reach(v)):
+        if abs(episode.turned) > GOING_ROUND:
+            return self._give_up(f"the detour turned {math.degrees(abs(episode.turned)):.0f} deg: it goes round the "
+                                 "obstacle, not past it", now)
+        if v < 0.0 or (v == 0.0 and w == 0.0):  # backing away (from a stall), stopping: the monitor's to judge
+            episode.clear_since = None
+            return Decision(v, w, "detour", passed=True)
+        if v > 0.0 and not stopped and not self._blocked(v, w, around, at_least=self._reach(v)):
             episode.held_since = None
             episode.clear_since = now if episode.clear_since is None else episode.clear_since
             if now - episode.clear_since >= self.settings.clear_time:
@@ -202,18 +211,16 @@ class Avoidance:
                                 passed=True)
             return Decision(v, w, "detour", passed=True)
         episode.clear_since = None
-        choice = choose(around, wished_curvature(v, w, self.arcs), self.arcs, reach=self._reach(v), side=episode.side,
-                        pose=pose, line=episode.line)
-        if choice.arc is not None and not stopped:
+        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v),
+                        side=episode.side, pose=pose, line=episode.line)
+        if choice.direction is not None and not stopped:
             episode.held_since = None
-        else:  # no arc will do, or the monitor stopped the last one: held
+        else:  # no direction will do, or the monitor stopped the last command: held
             episode.held_since = now if episode.held_since is None else episode.held_since
             if now - episode.held_since >= self.settings.timeout:
                 return self._give_up(self._blocked_reason(now - episode.held_since, v, w, around.points, choice), now)
-        if choice.arc is not None:
-            episode.side = episode.side or choice.side
-            return Decision(*self._arc(choice), "detour", choice)
-        return Decision(0.0, w if v == 0.0 else 0.0, "detour", choice)  # a turn on the spot sweeps nothing ahead
+        episode.side = episode.side or choice.side
+        return Decision(*steer(choice, around, self.avoid), "detour", choice)
 
     def _give_up(self, reason: str, now: float) -> Decision:
         self.reset(now)
@@ -245,29 +252,33 @@ class Avoidance:
         the collision monitor's to judge."""
         if v <= 0.0:
             return False
-        return not around.open(v, w, max(needed_distance(v, self.arcs), at_least))
+        return not around.open(v, w, max(needed_distance(v, self.avoid), at_least))
 
     def _ahead(self, v: float, w: float, points: np.ndarray) -> str:
         """Where the obstacle is, in words: along the wish's arc, or the nearest point."""
         if len(points) == 0:
             return "ahead"
-        along = free_distance(self.arcs.footprint, points, v, w) if v > 0.0 else math.inf
+        along = free_distance(self.avoid.footprint, points, v, w) if v > 0.0 else math.inf
         if math.isfinite(along):
             return f"{along:.2f} m ahead"
-        return f"{float(distance(self.arcs.footprint, points).min()):.2f} m away"
+        return f"{float(distance(self.avoid.footprint, points).min()):.2f} m away"
 
     def _blocked_reason(self, held: float, v: float, w: float, points: np.ndarray, choice: Choice) -> str:
         reason = f"blocked for {held:.0f} s by an obstacle {self._ahead(v, w, points)}"
         if choice.only_straying:
-            reason += f"; no way around within {self.arcs.max_stray:g} m of the path"
+            reason += f"; no way around within {self.avoid.max_stray:g} m of the path"
         return reason
 
-    def _reach(self, v: float) -> float:
-        """How far a detour's arc must be free: as far as the detour's speed needs, or the wish's, the
-        farther (an arc taken instead of the wish is free in the sense the wish was found blocked)."""
-        return max(needed_distance(self.arcs.speed, self.arcs), needed_distance(v, self.arcs))
+    def _wish(self, episode: _Episode, v: float, w: float, pose: Pose2D) -> float:
+        """Where the wish heads from the robot's heading now (rad). A forward command says it (eq. 4),
+        and is remembered in the odometry frame; a turn on the spot says only which way, so the
+        remembered heading stands for it (the turn's way while there is none), and the choice does
+        not swing as the robot turns."""
+        if v > 0.0 or episode.goal is None:
+            episode.goal = pose.theta + wished_direction(v, w, self.avoid)
+        return float(np.clip(wrap_angle(episode.goal - pose.theta), -self.avoid.spread, self.avoid.spread))
 
-    def _arc(self, choice: Choice) -> tuple[float, float]:
-        arc = choice.arc
-        assert arc is not None
-        return self.arcs.speed, arc.curvature * self.arcs.speed
+    def _reach(self, v: float) -> float:
+        """How far a detour's direction must be free: as far as the detour's speed needs, or the wish's,
+        the farther (a direction taken instead of the wish is free in the sense the wish was blocked)."""
+        return max(needed_distance(self.avoid.speed, self.avoid), needed_distance(v, self.avoid))

@@ -17,6 +17,8 @@ import numpy as np
 
 from perception.geometry import Pose2D
 
+RESOLUTION = 0.01  # m: remembered points closer than this are one
+
 
 def to_odometry(points: np.ndarray, pose: Pose2D) -> np.ndarray:
     """Base-frame points (N x 2) in the odometry frame, the base at ``pose``."""
@@ -54,4 +56,6 @@ class ObstacleMemory:
         recent = [p for t, p in zip(self.stamps, self.scans, strict=True) if t >= now - self.keep]
         if not recent:
             return np.zeros((0, 2))
-        return to_base(np.vstack(recent), pose)
+        points = np.vstack(recent)  # a transducer's reading repeats until it fires again: keep one of each
+        _, first = np.unique(np.round(points / RESOLUTION).astype(np.int64), axis=0, return_index=True)
+        return to_base(points[np.sort(first)], pose)

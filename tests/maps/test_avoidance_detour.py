@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from maps.avoidance.arcs import ArcSettings
 from maps.avoidance.detour import Avoidance, DetourSettings
+from maps.avoidance.sweep import AvoidSettings
 from perception.geometry import Pose2D
 from perception.polygons import disc
 
@@ -22,7 +22,7 @@ HERE = Pose2D()
 
 
 def avoidance(**detour: float) -> Avoidance:
-    return Avoidance(ArcSettings(disc(0.26)), DetourSettings(**detour))
+    return Avoidance(AvoidSettings(disc(0.26)), DetourSettings(**detour))
 
 
 def test_a_free_way_and_anything_but_driving_forwards_pass_unchanged():
@@ -61,11 +61,12 @@ def test_a_person_standing_still_is_driven_around_after_the_wait():
     for t in np.arange(0.0, 2.0, 0.1):
         assert a.step(0.3, 0.0, PERSON, HERE, float(t)).phase == "waiting"
     detour = a.step(0.3, 0.0, PERSON, HERE, 2.0)
-    assert detour.phase == "detour" and detour.choice is not None and detour.choice.arc is not None
-    assert detour.v == 0.2 and detour.w == pytest.approx(detour.choice.arc.curvature * 0.2) and detour.w != 0.0
-    assert detour.event.startswith("detour to the ") and detour.event.endswith(" after 2.0 s")
+    assert detour.phase == "detour" and detour.choice is not None and detour.choice.direction is not None
+    side = np.sign(detour.choice.direction.angle)
+    assert detour.w == pytest.approx(side * np.radians(45.0))  # more than 30 deg off the heading: turn first
+    assert detour.v == 0.0 and detour.event == f"detour to the {'left' if side > 0 else 'right'} after 2.0 s"
     # the person left behind: the wish's own arc is free again, it passes, and after clear_time the detour ends
-    past = Pose2D(0.8, 0.3 * np.sign(detour.w), 0.0)
+    past = Pose2D(0.8, 0.3 * side, 0.0)
     assert a.step(0.3, 0.0, NOTHING, past, 2.5).passed
     end = a.step(0.3, 0.0, NOTHING, past, 3.5)
     assert end.phase == "clear" and end.event.startswith("past the obstacle: a detour of 0.85 m")
@@ -89,9 +90,9 @@ def test_a_detour_that_would_stray_too_far_holds_and_gives_up_saying_so():
     a = avoidance(wait=0.0, timeout=5.0)
     assert a.step(0.3, 0.0, PERSON, HERE, 0.0).phase == "waiting"
     assert a.step(0.3, 0.0, PERSON, HERE, 0.1).phase == "detour"  # held at the origin, heading +x
-    # 1.45 m to the left of that line now, something ahead and on the right: only the sharper arcs to the
+    # 1.45 m to the left of that line now, something ahead and on the right: only the directions to the
     # left are free, and they end beyond 1.5 m
-    wall = np.array([[0.6, -0.2], [0.5, -0.3], [0.3, -0.4], [0.0, -0.4], [0.62, -0.05]])
+    wall = np.array([[0.5 * np.cos(a), 0.5 * np.sin(a)] for a in np.linspace(-2.2, 0.3, 12)])
     aside = Pose2D(0.5, 1.45, 0.0)
     held = a.step(0.3, 0.0, wall, aside, 0.2)
     assert held.choice is not None and held.choice.only_straying and (held.v, held.w) == (0.0, 0.0)
