@@ -2,12 +2,12 @@
 
 A person standing on a taught route stands on the places of a few viewframes (in the lab they
 are 0.2 m apart): route following homes to one of them, ``AvoidObstacles`` drives round the
-person and, since homing keeps pulling the robot back to a place it cannot reach, gives up. The
-robot is not lost then: it still sees the target viewframe. :class:`SkipViewframes` moves the
-target on to the farthest of the next ``window`` viewframes that it also sees (enough landmarks
-match, with a valid Z-infinity rotation, the rule ``FollowRoute`` follows by), so that following
-resumes beyond the obstacle. When the target itself does not match, the trail is lost, which is
-the search pattern's job (``SearchPattern``): FAILURE, and nothing changes.
+person and, since homing keeps pulling the robot back to a place it cannot reach, gives up (or
+the target is lost from view while the robot is off the route, behind the person).
+:class:`SkipViewframes` moves the target on to the farthest of the next ``window`` viewframes in
+view (enough landmarks match, with a valid Z-infinity rotation: the rule ``FollowRoute`` follows
+by), so that following resumes beyond the obstacle. When none of them is in view the trail is
+lost, which is the search pattern's job (``SearchPattern``): FAILURE, and nothing changes.
 
 In ``follow_route`` it is the recovery of the avoidance, inside the search's recovery::
 
@@ -46,8 +46,8 @@ def sees(tree: LandmarkTree, index: int, observation: Observation, min_matches: 
 class SkipViewframes(BearingsBehaviour):
     """Move the route's target on to the farthest of the next ``window`` viewframes in view.
 
-    SUCCESS with the new target (``skipped``); FAILURE when the target itself is not in view (the
-    trail is lost) or none of the next ones is.
+    SUCCESS with the new target (``skipped``); FAILURE when none of them is in view (the trail is
+    lost).
     """
 
     WINDOW = InputPort("window", int, 5, minimum=1, maximum=100, literal_only=True,
@@ -69,9 +69,6 @@ class SkipViewframes(BearingsBehaviour):
             self.feedback_message = "no route to skip along"
             return Status.FAILURE
         minimum, target = self.get_input(MIN_MATCHES), progress.target
-        if not sees(tree, target, observation, minimum, self._rng):
-            self.feedback_message = f"viewframe {target} is not in view: the trail is lost"
-            return Status.FAILURE
         last = tree.viewframe_count - 1
         ahead = [target + progress.direction * k for k in range(self.get_input(self.WINDOW), 0, -1)]
         for index in (i for i in ahead if 0 <= i <= last):
@@ -80,7 +77,7 @@ class SkipViewframes(BearingsBehaviour):
                 self.skips.append({"from": target, "to": index, "time_s": round(self.now(), 3)})
                 self.feedback_message = f"viewframe {target} cannot be reached: on to viewframe {index}"
                 return Status.SUCCESS
-        self.feedback_message = f"none of the {len(ahead)} viewframes past {target} is in view"
+        self.feedback_message = f"none of the {len(ahead)} viewframes past {target} is in view: the trail is lost"
         return Status.FAILURE
 
     def figures(self) -> Iterator[Figure]:

@@ -1,4 +1,4 @@
-"""SkipViewframes: past viewframes taught where something now stands, never for a lost trail."""
+"""SkipViewframes: past viewframes taught where something now stands; a lost trail is the search's."""
 
 from __future__ import annotations
 
@@ -35,7 +35,8 @@ def test_a_lost_trail_is_the_searchs_job():
     node, h = harness(3)
     nothing = Observation(np.zeros((0, 3)), 0.0, "bearings", ids=np.zeros(0, dtype=np.int64))
     h.write("/perception/observation", nothing)
-    assert h.tick() == Status.FAILURE and node.feedback_message == "viewframe 3 is not in view: the trail is lost"
+    assert h.tick() == Status.FAILURE
+    assert node.feedback_message == "none of the 5 viewframes past 3 is in view: the trail is lost"
     assert h.read("/map/route_progress").target == 3
 
 
