@@ -1,6 +1,6 @@
 """The blackboard keys the framework itself reads or writes, outside any mission node.
 
-Namespaces follow DESIGN.md: ``/robot``, ``/ptu``, ``/perception``, ``/map``, ``/mission``. Node
+Namespaces follow docs/design.md: ``/robot``, ``/ptu``, ``/perception``, ``/map``, ``/mission``. Node
 types declare the keys they read and write as ports (:mod:`behaviours.ports`); this module lists
 only the framework's own ends of the data flow, which the loader's data-flow check adds to what
 the mission's nodes declare:

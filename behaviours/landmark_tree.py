@@ -1,6 +1,6 @@
 """The LT-map on the blackboard: load it from a file, prune it to a memory budget.
 
-The map of a taught route (:class:`maps.ltmap.tree.LandmarkTree`, DESIGN.md algorithm 1) travels
+The map of a taught route (:class:`maps.ltmap.tree.LandmarkTree`, docs/design.md method 1) travels
 between nodes on ``/map/ltmap``: ``LearnRoute`` (:mod:`behaviours.teach`) or :class:`LoadMap`
 write it, :class:`PruneMap` shrinks it, the route-following nodes (:mod:`behaviours.route`,
 :mod:`behaviours.search`) read it. The file path is a literal port, so missions pass it as an
@@ -15,6 +15,7 @@ reached while following a pruned map with the place it was taught.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Iterator
 from typing import Any
 
@@ -90,7 +91,8 @@ class LoadMap(BearingsBehaviour):
 
     def figures(self) -> Iterator[Figure]:
         if self.summary is not None:
-            yield from section("ltmap", {"map_file": self.get_input(self.PATH), **summary_section(self.summary)})
+            yield from section("ltmap", {"map_file": os.path.abspath(self.get_input(self.PATH)),
+                                         **summary_section(self.summary)})
 
 
 @register
@@ -153,7 +155,14 @@ class PruneMap(BearingsBehaviour):
                         "memory_fraction": round(after / before, 4) if before else 1.0,
                         "viewframe_source": source.tolist()}
         self.feedback_message = f"{before} -> {after} bytes, {pruned.viewframe_count} viewframes"
+        if budget is not None and before:
+            # whole tree levels are cut: the map lands on the nearest cut under the budget, often well under it
+            self.section["memory_fraction_asked"] = round(budget / before, 4)
+            self.feedback_message += (f" ({after / before:.1%} of the map for {budget / before:.1%} asked: pruning "
+                                      "cuts whole tree levels, this is the nearest cut under the budget)")
         return Status.SUCCESS
 
     def figures(self) -> Iterator[Figure]:
-        yield from section("ltmap", self.section)
+        asked = "memory_fraction_asked" in self.section  # a budget was given: say what it gave
+        shown = ("memory_fraction_asked", "memory_fraction") if asked else ()
+        yield from section("ltmap", self.section, headline=shown)

@@ -26,7 +26,7 @@ class Perceive(BearingsBehaviour):
     under the mission's ``sense:``.
     """
 
-    CAMERA = InputPort("camera", str, "", doc="camera name; empty: the first camera", literal_only=True)
+    CAMERA = InputPort("camera", str, "", doc="camera name; empty: the first camera", literal_only=True, camera=True)
     FEATURES = InputPort("features", str, "orb", doc="detector", choices=available_kinds(), literal_only=True)
     MAX_FEATURES = InputPort("max_features", int, 500, doc="most features per frame", minimum=10, maximum=10000,
                              literal_only=True)

@@ -82,7 +82,9 @@ class InputPort(Generic[T]):
     change while it runs (they take no reference). ``file`` is :data:`READS` or :data:`WRITES`
     when the text names a file: relative paths are resolved against the mission's output folder
     before the node is built, and a written file must lie inside the output folders (checked at
-    load; such a port is ``str`` and ``literal_only``, see :func:`file_port_problem`).
+    load; such a port is ``str`` and ``literal_only``, see :func:`file_port_problem`). ``camera``
+    marks a text port that names the camera whose frames the node reads: a mission without
+    ``cameras:`` grabs the cameras its nodes name this way and no other (:mod:`missions.camera_use`).
 
     The port is generic in its value type, so ``node.get_input(SPEED)`` is a ``float`` to mypy
     (``InputPort("speed", float, ...)`` infers ``InputPort[float]``). A union type cannot be
@@ -99,6 +101,7 @@ class InputPort(Generic[T]):
     maximum: float | None = None
     literal_only: bool = False
     file: str = ""
+    camera: bool = False
 
     @property
     def required(self) -> bool:

@@ -1,4 +1,4 @@
-"""Route following on an LT-map: home to one viewframe after another (DESIGN.md, algorithm 1).
+"""Route following on an LT-map: home to one viewframe after another (docs/design.md, method 1).
 
 Three nodes share the work, composed in a mission (``follow_route.yaml``) with the control
 nodes rather than in one behaviour; what they compute about a viewframe is perception's
@@ -401,7 +401,7 @@ class ViewframeSwitch(BearingsBehaviour):
 
     def figures(self) -> Iterator[Figure]:
         rules = [r["rule"] for r in self.reached]
-        yield Figure("ltmap", "switches", len(self.reached))
+        yield Figure("ltmap", "switches", len(self.reached), headline=True)  # viewframes reached on the way
         yield Figure("ltmap", "switches_by_flip", rules.count("flip"))
         yield Figure("ltmap", "reached", list(self.reached))
 

@@ -130,7 +130,7 @@ class SearchPattern(BearingsBehaviour):
         return False
 
     def figures(self) -> Iterator[Figure]:
-        yield Figure("ltmap", "recoveries", self.recoveries)
+        yield Figure("ltmap", "recoveries", self.recoveries, headline=True)
         yield Figure("ltmap", "recoveries_found", self.found_again)
 
     def drawings(self) -> Iterator[Drawing]:

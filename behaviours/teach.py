@@ -16,6 +16,7 @@ turns those times into places with the simulator's ground-truth trajectory.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from typing import Any
 
@@ -135,8 +136,11 @@ class LearnRoute(BearingsDecorator):
         if tree is None:
             return
         taught = [{"viewframe": i, "time_s": t} for i, t in enumerate(self.taught)]
-        yield from section("ltmap", {**summary_section(tree.summary()), "map_file": self.get_input(self.PATH),
-                                     "saved": self.saved, "online_prunes": self.prunes, "taught": taught})
+        path = self.get_input(self.PATH)
+        written = os.path.abspath(path) if path else ""  # said at the end of the run: where the map went
+        yield from section("ltmap", {**summary_section(tree.summary()), "map_file": written, "saved": self.saved,
+                                     "online_prunes": self.prunes, "taught": taught},
+                           headline=("viewframes", "map_file"))
 
     def drawings(self) -> Iterator[Drawing]:
         """The viewframes made so far, where odometry put them (when there are new ones)."""

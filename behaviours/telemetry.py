@@ -29,17 +29,25 @@ Colour = tuple[int, int, int]
 
 @dataclass(frozen=True, slots=True)
 class Figure:
-    """One named value of the run report (JSON-able); numbers are plotted in the recording too."""
+    """One named value of the run report (JSON-able); numbers are plotted in the recording too.
+
+    ``headline``: the end-of-run line shows this figure (``bearings run`` prints it under the
+    status, and the report lists it under ``headline``): the few figures that say whether the
+    capability did its job, such as the area explored or the viewframes reached.
+    """
 
     section: str
     name: str
     value: Any
     unit: str = ""
+    headline: bool = False
 
 
-def section(name: str, values: Mapping[str, Any]) -> list[Figure]:
-    """The figures of one report section, from a mapping of names to values."""
-    return [Figure(name, key, value) for key, value in values.items()]
+def section(name: str, values: Mapping[str, Any], *, headline: Iterable[str] = ()) -> list[Figure]:
+    """The figures of one report section, from a mapping of names to values; the names in
+    ``headline`` are shown on the end-of-run line."""
+    shown = set(headline)
+    return [Figure(name, key, value, headline=key in shown) for key, value in values.items()]
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,12 +124,16 @@ class Draws(Protocol):
 
 @dataclass
 class Sections:
-    """Figures gathered into report sections (dotted names nested), in the order they came."""
+    """Figures gathered into report sections (dotted names nested), in the order they came;
+    ``headline`` lists the report paths (``section.name``) of the headline figures."""
 
     sections: dict[str, dict[str, Any]] = field(default_factory=dict)
+    headline: list[str] = field(default_factory=list)
 
     def add(self, figures: Iterable[Figure]) -> None:
         for figure in figures:
+            if figure.headline and (path := f"{figure.section}.{figure.name}") not in self.headline:
+                self.headline.append(path)
             target = self.sections.setdefault(figure.section, {})
             *parents, leaf = figure.name.split(".")
             for parent in parents:

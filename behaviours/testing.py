@@ -2,6 +2,8 @@
 
 Example::
 
+    from py_trees.common import Status
+
     from behaviours.motion import Drive
     from behaviours.testing import BehaviourHarness
     from perception.geometry import Pose2D

@@ -1,4 +1,4 @@
-"""Coverage of the configuration space by images (DESIGN.md, algorithm 2, "Coverage").
+"""Coverage of the configuration space by images (docs/design.md, method 2, "Coverage").
 
 The robot looks for the user's target images by visiting positions and taking 12 images at
 each, one per 30 degrees. A configuration is a robot position and heading, on a grid of

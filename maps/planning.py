@@ -1,4 +1,4 @@
-"""Motion planning between poses in the free space, with OMPL (DESIGN.md, algorithm 2).
+"""Motion planning between poses in the free space, with OMPL (docs/design.md, method 2).
 
 Used to reach coverage positions and to return to the reference pose. All poses are in the
 room estimate's reference frame; the free space is a :class:`maps.room.FreeGrid`.

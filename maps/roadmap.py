@@ -1,4 +1,4 @@
-"""The target roadmap: a non-Euclidean graph between target images (DESIGN.md, algorithm 2, "Graph").
+"""The target roadmap: a non-Euclidean graph between target images (docs/design.md, method 2, "Graph").
 
 Nodes are the user's target images, each with its pose relative to the reference pose (the room
 estimate's frame). An edge a -> b exists when the robot went from a to b and back: each way is

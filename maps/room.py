@@ -1,4 +1,4 @@
-"""Room estimate from the dodecagon's 12 stereo pairs (DESIGN.md, algorithm 2, "Room estimation").
+"""Room estimate from the dodecagon's 12 stereo pairs (docs/design.md, method 2, "Room estimation").
 
 The robot drives a regular dodecagon (:func:`dodecagon`); at each corner it takes a stereo pair
 of parallel images with the rig's known baseline, then turns 30 degrees. Depth along horizontal

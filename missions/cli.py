@@ -22,6 +22,7 @@ from importlib.metadata import EntryPoint, entry_points
 from typing import NoReturn
 
 from missions.commands import COMMANDS, ENTRY_POINT_GROUP
+from missions.threads import pin_thread_pools
 
 EPILOG = """exit codes: 0 mission SUCCESS / command done, 1 mission FAILURE, 2 invalid input,
 130/143 interrupted by SIGINT/SIGTERM.
@@ -71,6 +72,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    pin_thread_pools()  # before any command module imports numpy (missions/threads.py says why)
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):

@@ -48,6 +48,7 @@ from maps.store import (
 from missions.btcpp_reader import Draft, MissionDraft, Reader
 from missions.btcpp_xml import node_tag, parse_xml
 from missions.loader import load_mission
+from missions.plugins import PluginError, load_plugin
 
 
 # -- writing and checking the mission -------------------------------------------------------------
@@ -69,9 +70,11 @@ def dump_mission(document: dict[str, Any]) -> str:
     return dump_yaml(document)
 
 
-def render(mission: MissionDraft, source: str) -> str:
-    """The mission file's text."""
+def render(mission: MissionDraft, source: str, plugins: tuple[str, ...] = ()) -> str:
+    """The mission file's text (listing ``plugins``, whose node types the tree uses)."""
     document: dict[str, Any] = {"mission": mission.name}
+    if plugins:
+        document["plugins"] = list(plugins)
     if mission.sense:
         document["sense"] = [_plain(node) for node in mission.sense]
     document["tree"] = _plain(mission.tree)
@@ -131,15 +134,37 @@ def _in_xml(diagnostic: Diagnostic, path: str, file: str, starts: list[tuple[Sta
     return Diagnostic(file, element.line, element.col, prefix + diagnostic.message)
 
 
-def import_btcpp(path: str | os.PathLike, *, registry: Registry | None = None) -> str:
-    """The mission text for a BehaviorTree.CPP v4 file, validated; :class:`InputError` with every problem."""
+def import_btcpp(path: str | os.PathLike, *, registry: Registry | None = None, plugins: tuple[str, ...] = (),
+                 plugin_folder: str | os.PathLike = ".") -> str:
+    """The mission text for a BehaviorTree.CPP v4 file, validated; :class:`InputError` with every problem.
+
+    ``plugins`` (modules, or ``.py`` files in ``plugin_folder``, the folder the mission will be in)
+    provide node types the XML uses that bearings does not have: they are loaded for the import and
+    listed under the mission's ``plugins:``, so a mission with plugins survives the round trip.
+    """
     file = str(path)
     data = read_bytes(path, limit=MAX_FILE_BYTES, what="a BehaviorTree.CPP XML file")
     root = parse_xml(data, file)
-    reader = Reader(file, registry or Registry.default())
+    types = _with_plugins(registry or Registry.default(), plugins, Path(plugin_folder))
+    reader = Reader(file, types)
     mission = reader.mission(root)
     if reader.problems or mission is None:
         raise InputError(reader.problems)
-    text = render(mission, Path(file).name)
-    _validated(text, mission, file, registry)
-    return text
+    _validated(render(mission, Path(file).name), mission, file, types)  # the plugins' types already in
+    return render(mission, Path(file).name, plugins)
+
+
+def _with_plugins(registry: Registry, plugins: tuple[str, ...], folder: Path) -> Registry:
+    """A child of ``registry`` with the node types of ``plugins``; a plugin that fails is an InputError."""
+    if not plugins:
+        return registry
+    types = registry.child()
+    problems = []
+    for spec in plugins:
+        try:
+            load_plugin(spec, folder, types)
+        except PluginError as exc:
+            problems.append(Diagnostic(f"--plugin {spec}", 0, 0, str(exc)))
+    if problems:
+        raise InputError(problems)
+    return types

@@ -10,15 +10,41 @@ from __future__ import annotations
 import contextlib
 import re
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import yaml
 
-from behaviours.ports import REQUIRED, TYPE_NAMES, InputPort, check_literal, parse_ref
+from behaviours.ports import REQUIRED, TYPE_NAMES, InputPort, assignable, check_literal, parse_ref, type_name
 from maps.located import suggest
 from maps.store import Diagnostic, InputError, Mark, YamlList, parse_yaml
 
 SUBST = re.compile(r"\$\{([^}]*)\}")
+
+
+@dataclass(frozen=True)
+class Unbound:
+    """A required input not given, while a mission is only checked (``bearings validate``, ``show``).
+
+    It stands where ``${name}`` is written: ports check that the input's type fits them, text
+    shows ``${name}``. ``bearings run`` never gets one: there a required input not given stops
+    the run before anything moves (exit 2).
+    """
+
+    name: str
+    type: Any
+
+    def __str__(self) -> str:
+        return "${" + self.name + "}"
+
+
+def check_value(port: InputPort, value: Any) -> tuple[Any, str | None]:
+    """A literal checked against a port (:func:`check_literal`); an :class:`Unbound` input by its type."""
+    if isinstance(value, Unbound):
+        if assignable(value.type, port.type):
+            return value, None
+        return value, f"takes {type_name(port.type)}, but input ${{{value.name}}} is {type_name(value.type)}"
+    return check_literal(port, value)
 IDENT = re.compile(r"^[A-Za-z_]\w*$")
 
 
@@ -71,10 +97,12 @@ def parse_override(port: InputPort, text: str) -> Any:
 
 
 def bind(declared: Mapping[str, InputPort], given: Mapping[str, Any], *, file: str, marks: Mapping[str, Mark],
-         default_mark: Mark, texts: bool = False) -> tuple[dict[str, Any], list[Diagnostic]]:
+         default_mark: Mark, texts: bool = False, require: bool = True) -> tuple[dict[str, Any], list[Diagnostic]]:
     """Input values: defaults overridden by ``given``; unknown, missing or mistyped inputs are problems.
 
-    With ``texts`` the given values are ``--set`` texts (parsed by :func:`parse_override`).
+    With ``texts`` the given values are ``--set`` texts (parsed by :func:`parse_override`). A
+    required input not given is :class:`Unbound` (checking goes on without a cascade of errors),
+    and a problem unless ``require`` is false (a mission only checked, not run).
     """
     values: dict[str, Any] = {}
     problems: list[Diagnostic] = []
@@ -89,7 +117,7 @@ def bind(declared: Mapping[str, InputPort], given: Mapping[str, Any], *, file: s
             known = ", ".join(declared) or "none"
             problem(mark, f"unknown input {name!r}{suggest(name, declared)} (inputs: {known})")
             continue
-        value, error = check_literal(port, parse_override(port, value) if texts else value)
+        value, error = check_value(port, parse_override(port, value) if texts else value)
         if error:
             problem(mark, f"input {name!r} {error}")
             value = None if port.required else port.default  # keep checking without a cascade of errors
@@ -97,7 +125,10 @@ def bind(declared: Mapping[str, InputPort], given: Mapping[str, Any], *, file: s
     for name, port in declared.items():
         if name not in given:
             if port.required:
-                problem(default_mark, f"input {name!r} has no default and was not given")
+                values[name] = Unbound(name, port.type)
+                if require:
+                    how = f": give it with --set {name}=VALUE" if texts else " (the include's inputs: do not give it)"
+                    problem(default_mark, f"input {name!r} is required{how}" + (f" ({port.doc})" if port.doc else ""))
             else:
                 values[name] = port.default
     return values, problems

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -26,9 +26,11 @@ from behaviours.ports import InputPort
 from behaviours.registry import Registry
 from maps.located import diagnose, suggest
 from maps.store import Diagnostic, InputError, Mark, YamlList, YamlMap, load_yaml, mark_of
+from missions.camera_use import cameras_read
 from missions.dataflow import check_dataflow
 from missions.inputs import IDENT, bind, declaration, substitute
 from missions.language import MissionSpec, NodeSpec
+from missions.load_checks import load_checks
 from missions.model import Evaluation, InputDeclaration, MissionFile
 from missions.nodes import NodeReader, Scope
 from missions.outputs import confinement_problems, output_folders
@@ -226,6 +228,7 @@ def load_mission(
     search_path: Iterable[str | os.PathLike] = (),
     registry: Registry | None = None,
     output_dir: str | os.PathLike | None = None,
+    require_inputs: bool = False,
 ) -> MissionSpec:
     """Load and validate a mission file; raise :class:`InputError` listing every problem found.
 
@@ -236,26 +239,34 @@ def load_mission(
     mission's plugins are added to a child of it, never to it. ``output_dir``: where the mission's
     files go (``--output-dir``; see :mod:`missions.outputs`: relative paths resolve there, and a
     file written outside it and the mission's folder is refused).
+    mission's plugins are added to a child of it, never to it. A required input (declared without
+    a default) that ``overrides`` does not give is a problem with ``require_inputs`` (a mission to
+    run: ``bearings run`` says so before anything moves); without it the mission is checked with
+    the input :class:`~missions.inputs.Unbound` (``bearings validate``, ``show``).
     """
     env = [Path(p) for p in os.environ.get(PATH_ENV, "").split(os.pathsep) if p]
     loader = _Loader(search_path=[Path(p).resolve() for p in [*search_path, *env]],
                      registry=(registry or Registry.default()).child())
     file_path = resolve_mission_path(path)
+    if not file_path.exists():
+        raise InputError([_not_found(file_path)])
     doc = loader.document(file_path)
     if doc is None:
         raise InputError(loader.diagnostics)
     declared = loader.inputs(doc)
     values, problems = bind(declared, dict(overrides or {}), file="--set", marks={}, default_mark=Mark(0, 0),
-                            texts=True)
+                            texts=True, require=require_inputs)
     loader.diagnostics.extend(problems)
     scope = Scope(str(file_path), values, chain=(file_path.resolve(),))
+    before_nodes = len(loader.diagnostics)
     sense = _sense(loader, doc, scope)
     tree = loader.reader.node(doc.data["tree"], doc.data.value_mark_of("tree"), scope, 0)
+    nodes_whole = tree is not None and len(loader.diagnostics) == before_nodes
     evaluation = _evaluation(loader, doc, scope)
     cameras = _cameras(loader, doc, scope)
     folders = output_folders(file_path, output_dir, LIBRARY)
     loader.diagnostics.extend(confinement_problems([*sense, *([tree] if tree else [])], loader.registry, folders))
-    if loader.diagnostics or tree is None:
+    if tree is None or not nodes_whole:  # a node left out would make its outputs look unwritten below
         raise InputError(loader.diagnostics)
     header = doc.header
     mission = MissionSpec(
@@ -265,9 +276,13 @@ def load_mission(
         files=tuple(dict.fromkeys(loader.files)),
         cameras=cameras, registry=loader.registry, folders=folders,
     )  # fmt: skip
-    problems = check_dataflow(mission)
+    problems = [*loader.diagnostics, *check_dataflow(mission)]  # every problem at once, not in stages
+    if not problems:
+        problems = load_checks(mission)  # against what the files hold: only a mission whose flow is sound
     if problems:
         raise InputError(problems)
+    if cameras is None:  # grab what the nodes read, no more (missions/camera_use.py)
+        mission = replace(mission, cameras=cameras_read(mission))
     return mission
 
 
@@ -277,6 +292,15 @@ def resolve_mission_path(path: str | os.PathLike) -> Path:
     if not candidate.exists() and not candidate.suffix and (LIBRARY / f"{candidate}.yaml").is_file():
         return LIBRARY / f"{candidate}.yaml"
     return candidate
+
+
+def _not_found(path: Path) -> Diagnostic:
+    """A mission that is neither a file nor a shipped name: the shipped name it is most like, if any."""
+    shipped = sorted(p.stem for p in LIBRARY.glob("*.yaml"))
+    if path.suffix or len(path.parts) > 1:
+        return Diagnostic(str(path), 0, 0, "no such file")
+    return Diagnostic(str(path), 0, 0, f"no such file, and no shipped mission of that name{suggest(path.name, shipped)}"
+                      f" (bearings missions lists them: {', '.join(shipped)})")
 
 
 def _sense(loader: _Loader, doc: _Document, scope: Scope) -> tuple[NodeSpec, ...]:

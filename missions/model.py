@@ -84,3 +84,5 @@ class RunArguments(BaseModel):
     max_time: MaxTime | None = Field(None, alias="--max-time")
     overrun: Overrun | None = Field(None, alias="--overrun")
     seed: Seed = Field(0, alias="--seed")
+    image_rate: float | None = Field(None, ge=0.0, le=1000.0, alias="--image-rate",
+                                     description="camera images per second in a recording; 0: every frame")

@@ -14,11 +14,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from behaviours.ports import InputPort, OutputPort, check_literal, key_problem, parse_ref
+from behaviours.ports import InputPort, OutputPort, key_problem, parse_ref
 from behaviours.registry import NodeType, Registry
 from maps.located import describe_value, suggest
 from maps.store import Diagnostic, Mark, YamlList, YamlMap
-from missions.inputs import substitute
+from missions.inputs import check_value, substitute
 from missions.language import Location, NodeSpec
 
 MAX_DEPTH = 100
@@ -191,7 +191,7 @@ class NodeReader:
             problem = key_problem(ref.key, attributes=False)
             return ref.key, f"{owner}: {problem}" if problem else None
         if ref is None:
-            value, problem = check_literal(port, value)
+            value, problem = check_value(port, value)
             return value, f"{owner} {problem}" if problem else None
         if port.literal_only:
             return ref, f"{owner} takes a literal value, not a blackboard reference"

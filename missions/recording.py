@@ -1,4 +1,5 @@
-"""Record a run to a rerun file (``--save F.rrd``): robot pose, command, behaviour statuses.
+"""Record a run to a rerun file (``--save F.rrd``): robot pose, command, behaviour statuses,
+the camera images the mission grabbed (JPEG, at a watchable rate: :mod:`missions.images`).
 
 Uses rerun's global recording (``rr.init`` + ``rr.save``), which writes to the file with no
 viewer, so it works headless; open the file later with ``rerun F.rrd``.
@@ -7,7 +8,7 @@ viewer, so it works headless; open the file later with ``rerun F.rrd``.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +17,7 @@ import py_trees
 from py_trees.common import Status
 
 from behaviours.telemetry import Arrows, Drawing, Draws, Event, Lines, Picture, Plot, Points, Reports
+from missions.images import DEFAULT_RATE_HZ, ImageRate, jpeg
 
 FIGURE_PERIOD = 1.0  # s of the run's clock between two plots of the nodes' figures (some are costly to gather)
 STATUS_CODE = {Status.INVALID: 0, Status.RUNNING: 1, Status.SUCCESS: 2, Status.FAILURE: 3}
@@ -24,7 +26,8 @@ STATUS_CODE = {Status.INVALID: 0, Status.RUNNING: 1, Status.SUCCESS: 2, Status.F
 class Recorder:
     """Logs one entry per tick on the ``sim_time`` (or ``wall_time``) timeline."""
 
-    def __init__(self, path: str | Path, *, mission: str, recording_id: str, timeline: str) -> None:
+    def __init__(self, path: str | Path, *, mission: str, recording_id: str, timeline: str,
+                 image_rate_hz: float | None = DEFAULT_RATE_HZ) -> None:
         import rerun as rr  # imported here: the viewer wheel is large and only needed with --save
 
         self.rr = rr
@@ -35,11 +38,13 @@ class Recorder:
         rr.save(str(self.path))
         self._last_status: dict[str, Status] = {}
         self._last_figure: dict[str, Any] = {}
+        self.images = ImageRate(image_rate_hz)
         self._figures_at = -math.inf
         rr.log("tree/status_legend", rr.TextDocument("0 invalid, 1 running, 2 success, 3 failure"), static=True)
 
     def log_tick(self, *, time_s: float, tick: int, root: py_trees.behaviour.Behaviour, odometry: Any,
-                 command: Any, observers: Sequence[Any] = (), nodes: Sequence[Any] = ()) -> None:
+                 command: Any, observers: Sequence[Any] = (), nodes: Sequence[Any] = (),
+                 frames: Mapping[str, Any] | None = None) -> None:
         rr = self.rr
         rr.set_time(self.timeline, duration=time_s)
         rr.set_time("tick", sequence=tick)
@@ -57,6 +62,10 @@ class Recorder:
                 message = f"{path}: {node.status.value}" + (f" ({node.feedback_message})"
                                                              if node.feedback_message else "")
                 rr.log("tree/events", rr.TextLog(message))
+        for name, frame in self.images.due(frames or {}, time_s):
+            self.image(f"camera/{name}", frame.image)
+            if getattr(frame, "right", None) is not None:
+                self.image(f"camera/{name}_right", frame.right)
         for observer in observers:
             observer.log_rerun(rr)
         figures = time_s - self._figures_at >= FIGURE_PERIOD
@@ -64,6 +73,10 @@ class Recorder:
             self._figures_at = time_s
         for node in nodes:
             self.log_node(node, figures=figures)
+
+    def image(self, entity: str, image: Any) -> None:
+        """One image, JPEG-encoded (a tenth of the raw bytes of a camera image)."""
+        self.rr.log(entity, self.rr.EncodedImage(contents=jpeg(image), media_type="image/jpeg"))
 
     def log_node(self, node: Any, *, figures: bool = True) -> None:
         """A node's drawings, and with ``figures`` its figures (the numbers that changed since last plotted)."""
@@ -95,7 +108,7 @@ class Recorder:
             case Arrows(entity, vectors, colours, origins):
                 rr.log(entity, rr.Arrows2D(vectors=vectors, origins=origins, colors=_colours(colours)))
             case Picture(entity, image):
-                rr.log(entity, rr.Image(image))
+                self.image(entity, image)
             case Event(entity, text):
                 rr.log(entity, rr.TextLog(text))
             case Plot(entity, value):

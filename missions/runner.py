@@ -33,6 +33,11 @@ tick ``/robot/safety`` holds the monitor's state, the recording gets an event li
 intervention, and the report a ``safety`` section (stops and slow-downs counted as episodes,
 bumper hits, the nearest range, the first events).
 
+With ``record_path`` (``--record``) every device of the robot records what it delivers and what
+it is sent (:class:`~drivers.logs.record.SensorLog`, inside the collision monitor: the base's
+commands are the ones sent), the tree's own command and the clock once per tick; the file is
+closed on every way the run ends and the report gets a ``record`` section.
+
 Capabilities add to the report and the recording without touching the runner: any node of the
 tree may report ``figures()`` (named values, gathered into the report's sections: ``ltmap``,
 ``roadmap``, ``exploration``; numbers are plotted in the recording too) and ``drawings()``
@@ -54,7 +59,7 @@ import traceback
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import py_trees
 from py_trees.common import Status
@@ -64,16 +69,22 @@ from behaviours.keys import COMMAND_KEYS, SAFETY_KEY, input_key
 from behaviours.telemetry import Draws, Event, Plot, Reports, Sections
 from drivers.interfaces import STOP, KeyboardOpener, PanTiltCommand, Robot, VelocityCommand
 from drivers.keyboard import TerminalKeys
+from drivers.logs.camera_codec import ImageFormat
 from drivers.pioneer_body import BODIES
 from drivers.safety.guarded_base import GuardedBase
 from drivers.safety.settings import monitor_config
 from maps.store import write_json
 from missions.builder import build_root
 from missions.clocks import WallClock
+from missions.images import DEFAULT_RATE_HZ
 from missions.language import MissionSpec
 from missions.recording import Recorder
 from missions.safety import Interrupted, SafetyMonitor, exit_code
+from missions.summary import declared_headline
 from perception.collision_monitor import CollisionMonitor, MonitorConfig
+
+if TYPE_CHECKING:
+    from drivers.logs.record import SensorLog
 
 
 class RunObserver(Protocol):
@@ -93,9 +104,11 @@ class RunOptions:
     overrun_s: float | None = None  # tick watchdog limit; None: the mission's on a robot, none in simulation
     report_path: Path | None = None
     save_path: Path | None = None
-    progress: bool = False
+    image_rate_hz: float | None = DEFAULT_RATE_HZ  # camera images per second in the recording; None or 0: every frame
     seed: int = 0
     debug: bool = False  # print the traceback of an exception in the tree
+    record_path: Path | None = None  # --record: every sensed input and command, as ROS 2 messages in MCAP
+    record_images: ImageFormat = field(default_factory=ImageFormat)
 
 
 @dataclass
@@ -132,9 +145,16 @@ class Runner:
         safety: MonitorConfig | None = None,
     ) -> None:
         self.mission = mission
-        self.keyboard = keyboard  # opened by a node that drives by keys, when it first runs
         self.options = options or RunOptions()
         self.clock: TickClock = clock or WallClock()
+        self.sensor_log: SensorLog | None = None
+        if self.options.record_path is not None:  # devices record what they deliver and are sent, inside the monitor
+            from drivers.logs.record import SensorLog  # MCAP's libraries load only when a run records
+
+            self.sensor_log = SensorLog(self.options.record_path, images=self.options.record_images)
+            robot = self.sensor_log.wrap(robot, self.clock.now)
+            keyboard = self.sensor_log.wrap_keyboard(keyboard)
+        self.keyboard = keyboard  # opened by a node that drives by keys, when it first runs
         config = safety or monitor_config(None, BODIES["p3dx"].footprint)
         self.guard = GuardedBase(robot.base, CollisionMonitor(config), robot.ranges, self.clock.now)
         self.robot = dataclasses.replace(robot, base=self.guard)  # the tree and the stops see the guarded base
@@ -194,7 +214,9 @@ class Runner:
         if self.options.save_path is not None:
             self._recorder = Recorder(self.options.save_path, mission=self.mission.name,
                                       recording_id=f"{self.mission.name}-seed{self.options.seed}",
-                                      timeline=self.clock.timeline)
+                                      timeline=self.clock.timeline, image_rate_hz=self.options.image_rate_hz)
+        if self.sensor_log is not None:
+            self.sensor_log.open(mission=self.mission.name, timeline=self.clock.timeline, rate_hz=self.rate_hz)
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
         self.blackboard.set(SAFETY_KEY.path, self.guard.state)
@@ -203,7 +225,6 @@ class Runner:
         self._drawers = [node for node in self.root.iterate() if isinstance(node, Reports | Draws)]
 
     def _loop(self) -> tuple[str, str]:
-        last_progress = 0.0
         while True:
             stop = self.monitor.stopped_reason
             if stop is not None:
@@ -220,9 +241,6 @@ class Runner:
                 return "FAILURE", self.monitor.fault
             if self.on_tick is not None:
                 self.on_tick(self)
-            if self.options.progress and time.monotonic() - last_progress > 0.2:
-                last_progress = time.monotonic()
-                self._print_progress(now)
             if self.root.status in (Status.SUCCESS, Status.FAILURE):
                 return self.root.status.value, self._outcome_reason()
             self.clock.next_tick(self.period)
@@ -231,6 +249,8 @@ class Runner:
         """Stop everything, halt the tree, record the stop (runs whatever happened)."""
         self.robot.stop_all()  # the last command sent is always a stop
         self.last_command = STOP
+        if self.sensor_log is not None:
+            self.sensor_log.close()
         with contextlib.suppress(Exception):  # halting must not mask the outcome
             if self.root.status == Status.RUNNING:
                 self.root.stop(Status.INVALID)
@@ -238,8 +258,6 @@ class Runner:
             with contextlib.suppress(Exception):  # the run's outcome matters more than the file
                 self._recorder.log_stop(time_s=self.clock.now(), tick=self.ticks)
                 self._recorder.close()
-        if self.options.progress:
-            sys.stderr.write("\n")
 
     def _result(self, status: str, reason: str) -> RunResult:
         result = RunResult(status, reason, self.ticks, self.clock.now(), signum=self.monitor.signum)
@@ -255,6 +273,8 @@ class Runner:
     def _emergency_exit(self, signum: int) -> None:
         """Called by the monitor when a signal came and the loop is stuck: report, then end the process."""
         self.robot.stop_all()
+        if self.sensor_log is not None:
+            self.sensor_log.close()
         with contextlib.suppress(Exception):
             reason = f"{self.monitor.stopped_reason}; the tree did not return, the process was ended"
             self._result("INTERRUPTED", reason)
@@ -277,6 +297,8 @@ class Runner:
         self.robot.base.drive(asked.v, asked.w)  # through the collision monitor
         self.last_command = VelocityCommand(asked.v * self.guard.state.ratio, asked.w * self.guard.state.ratio)
         self.blackboard.set(SAFETY_KEY.path, self.guard.state)
+        if self.sensor_log is not None:
+            self.sensor_log.tick(asked)
         ptu_command = self._get("/ptu/command")
         if self.robot.ptu is not None and isinstance(ptu_command, PanTiltCommand) and ptu_command != self._last_ptu:
             self.robot.ptu.move(ptu_command.pan, ptu_command.tilt, ptu_command.speed)
@@ -284,7 +306,8 @@ class Runner:
         if self._recorder is not None:
             self._recorder.log_tick(time_s=self.clock.now(), tick=self.ticks + 1, root=self.root,
                                     odometry=self._get("/robot/odometry"), command=self.last_command,
-                                    observers=self.observers, nodes=self._drawers)
+                                    observers=self.observers, nodes=self._drawers,
+                                    frames=self._get("/perception/frames"))
             self._recorder.draw(Plot("safety/ratio", self.guard.state.ratio))
             for event in self.guard.log.take_new():
                 self._recorder.draw(Event("safety/events", event.line()))
@@ -296,7 +319,7 @@ class Runner:
         except KeyError:
             return None
 
-    def _node_sections(self) -> dict[str, dict[str, Any]]:
+    def _node_sections(self) -> Sections:
         """What the tree's nodes add to the report (a node that fails to say is noted, not fatal)."""
         gathered = Sections()
         for node in self.root.iterate():
@@ -305,7 +328,7 @@ class Runner:
                     gathered.add(node.figures())
             except Exception as exc:  # noqa: BLE001 - the report must be written whatever a node does
                 gathered.sections.setdefault("report_errors", {})[node.name] = describe_exception(exc)
-        return gathered.sections
+        return gathered
 
     def _outcome_reason(self) -> str:
         if self.root.status == Status.SUCCESS:
@@ -317,13 +340,6 @@ class Runner:
             detail = f": {node.feedback_message}" if node.feedback_message else ""
             return f"{node.name} failed{detail}"
         return "mission tree failed"
-
-    def _print_progress(self, now: float) -> None:
-        tip = self.task.tip()
-        active = "" if tip is None else tip.name + (f": {tip.feedback_message}" if tip.feedback_message else "")
-        line = f"[{self.mission.name}] t={now:7.1f} s  tick {self.ticks:6d}  {active}"
-        sys.stderr.write("\r" + line[:110].ljust(110))
-        sys.stderr.flush()
 
     def _report(self, result: RunResult) -> dict[str, Any]:
         mission = self.mission
@@ -343,13 +359,17 @@ class Runner:
             report["sim_time_s"] = round(result.time_s, 6)
         for observer in self.observers:
             report.update(observer.report_sections(mission.evaluation))
-        for name, values in self._node_sections().items():
+        nodes = self._node_sections()
+        for name, values in nodes.sections.items():
             report.setdefault(name, {}).update(values)
         report["safety"] = self.guard.log.summary()
+        if self.sensor_log is not None:
+            report["record"] = self.sensor_log.summary()
         for device in (self.guard.base, self.robot.ptu):
             sections = getattr(device, "report_sections", None)
             if callable(sections):
                 report.update(sections())
+        report["headline"] = declared_headline([*self.observers, self.robot.base, self.robot.ptu], nodes.headline)
         odometry = self._get("/robot/odometry")
         if odometry is not None:
             report["odometry"] = {"x": odometry.x, "y": odometry.y, "theta": odometry.theta}

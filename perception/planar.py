@@ -1,4 +1,4 @@
-"""Homing by the planar essential matrix (Shimshoni & Rivlin; DESIGN.md, algorithm 2).
+"""Homing by the planar essential matrix (Shimshoni & Rivlin; docs/design.md, method 2).
 
 Inputs are N x 2 NORMALISED image coordinates of a pinhole camera (OpenCV optical convention:
 x right, y down, z forward; undistort with ``PinholeCamera.normalised``) of the same points in a
@@ -276,7 +276,7 @@ def _refine(data: _Data, e: np.ndarray, threshold: float, rounds: int = 3) -> np
     2. plain least squares (the maximum-likelihood fit for Gaussian keypoint noise) on the points
        within ``c`` of the result, re-selected and re-fitted until the set settles.
 
-    On issue 13's scenes (1 px noise, threshold 2 px) the median rotation error goes from 0.142
+    On the synthetic roadmap scenes (1 px noise, threshold 2 px) the median rotation error goes from 0.142
     deg (least squares on the RANSAC inliers) to 0.118; a fit on the true inliers gets 0.104
     (docs/perception.md, "Planar homing").
     """

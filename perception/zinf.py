@@ -1,6 +1,6 @@
 """Z-infinity: rotation and direction of translation between two sets of landmark bearings.
 
-Jäger, Mair et al., IROS 2013 (DESIGN.md, algorithm 1). ``ref`` and ``cur`` are N x 3 unit
+Jäger, Mair et al., IROS 2013 (docs/design.md, method 1). ``ref`` and ``cur`` are N x 3 unit
 bearings of the same landmarks seen from a reference place (a viewframe) and from the current
 place, in the camera body frame (x forward, y left, z up).
 

@@ -38,7 +38,7 @@ class LocalisePose(BearingsBehaviour):
     belongs under the mission's ``sense:``); before the first odometry it writes nothing.
     """
 
-    CAMERA = InputPort("camera", str, "landmarks", literal_only=True,
+    CAMERA = InputPort("camera", str, "landmarks", literal_only=True, camera=True,
                        doc="the bearings sensor (identified landmarks) to correct with")
     MOUNT = InputPort("mount", list[float], [0.0, 0.0, 0.0], unit="m, m, deg", literal_only=True,
                       doc="where the sensor sits on the base: x, y, yaw")

@@ -52,7 +52,8 @@ class MapStereo(BearingsBehaviour):
     at the true poses.
     """
 
-    CAMERA = InputPort("camera", str, "stereo", literal_only=True, doc="the stereo pair on the pan-tilt unit")
+    CAMERA = InputPort("camera", str, "stereo", literal_only=True, camera=True,
+                       doc="the stereo pair on the pan-tilt unit")
     PERIOD = InputPort("period", float, 0.4, unit="s", minimum=0.0, maximum=60.0, literal_only=True,
                        doc="at most one integration per period (stereo matching costs ~0.1 s)")
     NUM_DISPARITIES = InputPort("num_disparities", int, 96, minimum=16, maximum=256, literal_only=True,
@@ -139,12 +140,12 @@ class MapStereo(BearingsBehaviour):
     def figures(self) -> Iterator[Figure]:
         """The ``exploration`` section's map part (see the class docstring)."""
         if self.map is None:
-            yield Figure("exploration", "explored_area_m2", 0.0)
+            yield Figure("exploration", "explored_area_m2", 0.0, headline=True)
             return
         m, f = self.map, self.map.frame
         head = self.head or StereoHead(self._ptu, self._camera)
         area = [round(self.now(), 2), round(m.explored_area, 3), round(self.path_length, 3)]
-        yield from (Figure("exploration", name, value) for name, value in (
+        yield from (Figure("exploration", name, value, headline=name == "explored_area_m2") for name, value in (
             ("explored_area_m2", m.explored_area),
             ("obstacle_area_m2", float(np.count_nonzero(m.cells == Cell.OBSTACLE)) * f.resolution**2),
             ("path_length_m", self.path_length),

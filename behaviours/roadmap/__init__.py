@@ -1,4 +1,4 @@
-"""The roadmap behaviours (DESIGN.md, algorithm 2; issue 13): learn a roadmap between a few target
+"""The roadmap behaviours (docs/design.md, method 2): learn a roadmap between a few target
 images and navigate it. Thin over :mod:`maps.room`, :mod:`maps.coverage`, :mod:`maps.roadmap`,
 :mod:`maps.planning`, :mod:`perception.planar` and :mod:`perception.stereo`.
 

@@ -1,4 +1,4 @@
-"""Coverage scoring: the next position to search from (DESIGN.md, algorithm 2, "Coverage").
+"""Coverage scoring: the next position to search from (docs/design.md, method 2, "Coverage").
 
 The configuration space (x, y at 10 cm, heading at 5 degrees) inside the room's free space is
 covered by the images taken at search positions; the next position is the one whose 12 images

@@ -1,4 +1,4 @@
-"""Building the roadmap's graph by driving between targets (DESIGN.md, algorithm 2, "Graph").
+"""Building the roadmap's graph by driving between targets (docs/design.md, method 2, "Graph").
 
 Paper: an edge a -> b exists when the robot went from a to b and back; the two estimates are
 fused by covariance; an edge stores rotate(angle1), drive(dist), rotate(angle2). Every pair of

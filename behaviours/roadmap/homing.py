@@ -1,4 +1,4 @@
-"""Homing to a target image by the planar essential matrix (DESIGN.md, algorithm 2, "Homing").
+"""Homing to a target image by the planar essential matrix (docs/design.md, method 2, "Homing").
 
 The routine :func:`home` drives the robot to where a target image was taken; ``TargetHoming``,
 ``ReturnToReference``, ``BuildGraph`` and ``NavigateToTarget`` all use it.

@@ -1,4 +1,4 @@
-"""Navigating the roadmap to a target from an unknown pose (DESIGN.md, algorithm 2, "Navigation").
+"""Navigating the roadmap to a target from an unknown pose (docs/design.md, method 2, "Navigation").
 
 Paper: rotate and try to match any graph image; when none matches, move randomly and retry;
 then take the shortest path (edge cost sigma_x + sigma_y), homing at each node to remove drift.
@@ -40,6 +40,7 @@ from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, 
 from behaviours.roadmap.scan import scan
 from behaviours.roadmap.values import NavigationResult, TargetImages
 from behaviours.telemetry import Drawing, Figure
+from maps.located import suggest
 from maps.roadmap import EdgeMotion, Roadmap
 
 
@@ -71,6 +72,15 @@ class NavigateToTarget(RoutineBehaviour):
         self.result: NavigationResult | None = None
         self.rng = np.random.default_rng(0)  # re-seeded from the seed port when the routine starts
         self.drawn = Drawn()
+
+    @classmethod
+    def check_inputs(cls, inputs: dict[str, Any]) -> list[str]:
+        """At load time: the target is one the roadmap has, when the roadmap file exists already."""
+        goal, roadmap = inputs.get(cls.TARGET.name), inputs.get(cls.ROADMAP.name)
+        if not isinstance(goal, str) or not isinstance(roadmap, Roadmap) or goal in roadmap.names:
+            return []
+        return [f"no target named {goal!r} in the roadmap{suggest(goal, roadmap.names)} "
+                f"(it has: {', '.join(roadmap.names) or 'none'})"]
 
     def routine(self) -> Step[None]:
         goal = self.get_input(self.TARGET)

@@ -1,4 +1,4 @@
-"""Room estimation on a dodecagon (DESIGN.md, algorithm 2, "Room estimation"; :mod:`maps.room`).
+"""Room estimation on a dodecagon (docs/design.md, method 2, "Room estimation"; :mod:`maps.room`).
 
 The robot drives a regular dodecagon: at each of its 12 corners it takes a stereo pair with the
 pan-tilt head level at pan 0 (parallel images, known baseline), then turns 30 degrees and
@@ -73,7 +73,7 @@ class RoomEstimationDodecagon(RoutineBehaviour):
 
     SIDE = InputPort("side", float, 0.25, unit="m", minimum=0.05, maximum=2.0,
                      doc="side of the dodecagon (corners on a circle of radius 1.93 x side)")
-    STEREO_CAMERA = InputPort("stereo_camera", str, "stereo", literal_only=True,
+    STEREO_CAMERA = InputPort("stereo_camera", str, "stereo", literal_only=True, camera=True,
                               doc="the stereo camera on the pan-tilt head")
     STEREO = InputPort("stereo", str, "dense", choices=("dense", "sparse"), literal_only=True,
                        doc="stereo matching: dense (SGBM) or sparse (features along epipolar lines)")

@@ -48,7 +48,7 @@ class Failed(Exception):
     """A routine cannot go on; the behaviour fails and reports this reason."""
 
 
-CAMERA = InputPort("camera", str, "front", literal_only=True,
+CAMERA = InputPort("camera", str, "front", literal_only=True, camera=True,
                    doc="camera that takes the homing and scan images (pinhole, on the level pan-tilt head at pan 0)")
 CAMERA_OFFSET = InputPort("camera_offset", list[float], [0.15, 0.0], unit="m", literal_only=True,
                           doc="that camera's position on the robot (x forward, y left) at pan 0")

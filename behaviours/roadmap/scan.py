@@ -1,4 +1,4 @@
-"""Scanning a position for target images (DESIGN.md, algorithm 2, "Coverage"; "Navigation").
+"""Scanning a position for target images (docs/design.md, method 2, "Coverage"; "Navigation").
 
 At a position the robot takes ``images`` (12) images, turning 360 / images degrees between them,
 and compares each with the target images not found yet (upright SIFT, ratio 0.65, planar

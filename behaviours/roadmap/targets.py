@@ -109,6 +109,14 @@ class LoadRoadmap(BearingsBehaviour):
     ROADMAP = OutputPort("roadmap", Roadmap, "/map/roadmap", doc="targets (reference frame) and edges")
     PORTS = (FILE, MAX_FEATURES, ROADMAP, TARGETS_OUT)
 
+    @classmethod
+    def preview_outputs(cls, inputs: dict[str, Any]) -> dict[str, Any]:
+        """At load time: the roadmap, when its file exists already (``missions/load_checks.py``)."""
+        file = inputs.get(cls.FILE.name)
+        if not isinstance(file, str) or not Path(file).is_file():
+            return {}
+        return {cls.ROADMAP.name: Roadmap.load(file)}
+
     def update(self) -> Status:
         path = Path(self.get_input(self.FILE))
         try:

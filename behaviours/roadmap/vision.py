@@ -1,6 +1,6 @@
 """The image side of the roadmap behaviours: features, matching and planar homing against a target.
 
-Roadmap paper (DESIGN.md, algorithm 2): SIFT with a fixed (upright) orientation, the ratio test
+Roadmap paper (docs/design.md, method 2): SIFT with a fixed (upright) orientation, the ratio test
 at 0.65, and the planar essential matrix between the current image and a target image. Pure
 functions over :mod:`perception`; the behaviours call them on frames they took.
 

@@ -254,6 +254,9 @@ class Simulation:
     # ----------------------------------------------------------------------------------------
     # Ground truth (evaluation only)
 
+    HEADLINE = ("ground_truth.goal_error_m", "ground_truth.path_error_m", "ground_truth.trajectory_length_m")
+    """The ground-truth figures the end-of-run line shows (besides collisions: ``missions/summary.py``)."""
+
     def report_sections(self, evaluation: Mapping[str, Any]) -> dict[str, Any]:
         """What a run report gets from the simulator: ``ground_truth`` against the mission's
         ``evaluation`` references (``goal``, ``reference_path``, ``frame``)."""
@@ -288,7 +291,7 @@ class Simulation:
         reference_path: Sequence[Sequence[float]] | None = None,
         frame: str = "world",
     ) -> dict:
-        """The ``ground_truth`` section of a run report (DESIGN.md, contracts).
+        """The ``ground_truth`` section of a run report (docs/design.md, contracts).
 
         Always: ``trajectory_length_m``, ``final_pose``, ``odometry_drift_m``, ``collisions`` (every
         contact episode: the robot ran into something), ``collisions_with_people`` (those of them
@@ -323,6 +326,9 @@ class Simulation:
             "trajectory": _decimate(true, max_points=2000),
             "stops": _stops(true),
             "landmarks": [[int(lm.id), lm.x, lm.y, lm.z] for lm in self.world.landmarks],
+            # where odometry believed the robot was, (t, x, y) in the world (odometry starts at the true start)
+            "odometry_trajectory": _decimate(np.column_stack([np.asarray(self.truth.odometry)[:, 0],
+                                                              self.odometry_trajectory_in_world()]), max_points=2000),
         }
         if goal is not None:
             report["goal_error_m"] = float(math.hypot(xy[-1, 0] - goal[0], xy[-1, 1] - goal[1]))
@@ -368,15 +374,13 @@ class Simulation:
     # ----------------------------------------------------------------------------------------
     # Visualisation
 
-    def log_rerun(self, rec: Any, *, image_every: int | None = None) -> None:
+    def log_rerun(self, rec: Any) -> None:
         """Log this tick to rerun (``rec``: the rerun module or a RecordingStream).
 
         Once: the world from above (walls, pillars, landmarks, named poses, static). Every call:
         the true and odometry poses, heading and pan-tilt view direction. Every 20th call: the
-        trajectories. Every ``image_every``-th call (default 10): the latest frame of each camera.
+        trajectories. Camera images are the recorder's (the frames the mission grabbed).
         """
-        if image_every is not None:
-            self._rerun.image_every = max(1, int(image_every))
         self._rerun.log(self, rec)
 
 

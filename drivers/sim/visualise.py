@@ -1,11 +1,11 @@
-"""Logging a simulation to rerun: the world from above, trajectories, camera images, pan-tilt view.
+"""Logging a simulation to rerun: the world from above, trajectories, pan-tilt view.
 
 The simulation calls :meth:`RerunLogger.log` once per recorded tick, handing itself in as the
 :class:`Simulated` it is (this module does not know the simulation, only what it reads of it).
 The world is logged once (static); poses are two points per tick, the people (they move) a point
-each; the trajectories are re-logged as line strips only every ``trail_every`` ticks (decimated),
-and camera images only every ``image_every`` ticks and only when the camera grabbed a new frame:
-logging never renders.
+each; the trajectories are re-logged as line strips only every ``trail_every`` ticks (decimated).
+Camera images are not the simulator's to log: the recorder logs the frames the mission grabbed,
+on a robot as here (``missions/images.py``).
 """
 
 from __future__ import annotations
@@ -19,7 +19,6 @@ import numpy as np
 from drivers.sim.cameras import SimCamera
 from drivers.sim.ptu import SimPanTilt
 from drivers.sim.world_values import World
-from perception.frame import Frame
 from perception.geometry import Pose2D
 
 WALL_COLOUR = (200, 200, 200)
@@ -55,13 +54,11 @@ class Simulated(Protocol):
 class RerunLogger:
     """Per-simulation rerun logging state (what was logged already, tick counter)."""
 
-    def __init__(self, *, image_every: int = 10, trail_every: int = 20, max_trail: int = 2000) -> None:
-        self.image_every = max(1, int(image_every))
+    def __init__(self, *, trail_every: int = 20, max_trail: int = 2000) -> None:
         self.trail_every = max(1, int(trail_every))
         self.max_trail = max_trail
         self._ticks = 0
         self._world_logged = False
-        self._image_stamps: dict[str, float] = {}
 
     def log(self, sim: Simulated, rec: Any) -> None:
         """Log this tick; ``rec`` is the ``rerun`` module or a ``rerun.RecordingStream``."""
@@ -79,15 +76,6 @@ class RerunLogger:
                 if len(rows) > self.max_trail:
                     rows = rows[np.linspace(0, len(rows) - 1, self.max_trail).round().astype(int)]
                 rec.log(f"world/ground_truth/trajectory_{name}", rr.LineStrips2D([rows], colors=[colour], radii=0.02))
-        if self._ticks % self.image_every == 0:
-            for name, camera in sim.cameras.items():
-                frame = camera.last
-                if not isinstance(frame, Frame) or self._image_stamps.get(name) == frame.stamp:
-                    continue
-                self._image_stamps[name] = frame.stamp
-                rec.log(f"camera/{name}", rr.Image(frame.image))
-                if frame.right is not None:
-                    rec.log(f"camera/{name}_right", rr.Image(frame.right))
         self._ticks += 1
 
     @staticmethod

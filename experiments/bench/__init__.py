@@ -10,4 +10,5 @@ AREAS = {
     "perception": "experiments.bench.perception",
     "ltmap": "experiments.bench.ltmap",
     "sweep": "experiments.bench.sweep",
+    "run": "experiments.bench.run",
 }

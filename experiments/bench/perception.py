@@ -15,7 +15,7 @@
    correspondences in front of both cameras (``pinhole_correspondences``): Z-infinity gets all.
 3. Planar homing (3 degrees of freedom) next to two general 5-point relative-pose estimators,
    PoseLib's ``estimate_relative_pose`` (LO-RANSAC + refinement) and OpenCV's
-   ``findEssentialMat`` + ``recoverPose`` (``RANSAC``, and ``USAC_MAGSAC``), on issue 13's scenes:
+   ``findEssentialMat`` + ``recoverPose`` (``RANSAC``, and ``USAC_MAGSAC``), on the synthetic roadmap scenes:
    150 points in the field of view of the simulator's 640 x 480 front camera, 1 px noise, 25%
    outliers, a random turn and step, the same pixel correspondences and the same 2 px inlier
    threshold for all (:func:`planar_comparison`). ``planar_vs_X_*_ratio`` = ours / theirs, from
@@ -356,7 +356,7 @@ def planar_comparison(
 
 
 def planar_figures(quick: bool) -> dict[str, Any]:
-    """Planar homing vs PoseLib's and OpenCV's general (5-point) relative pose on issue 13's scenes."""
+    """Planar homing vs PoseLib's and OpenCV's general (5-point) relative pose on the synthetic roadmap scenes."""
     trials = 12 if quick else 100
     cv2.setRNGSeed(0)
     rows = planar_comparison(range(trials))

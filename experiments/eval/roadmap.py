@@ -1,5 +1,5 @@
 """``bearings eval roadmap``: learn a roadmap from a few target images, then navigate to its targets
-from unknown start poses (DESIGN.md's algorithm 2, ``docs/roadmap.md``).
+from unknown start poses (docs/design.md's method 2, ``docs/roadmap.md``).
 
 Episodes (all through the sweep runner, in the results folder), per seed:
 

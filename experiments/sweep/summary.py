@@ -1,5 +1,7 @@
-"""Summaries of a results table: per parameter combination, the success rate and the mean and spread
-of every numeric figure; a printed table; a plot of one figure against one swept parameter.
+"""Summaries of a results table: per parameter combination, the success rate, the commonest reasons
+of the runs that did not succeed, and the mean and spread of every numeric figure; a printed table
+(with the reasons under it: a sweep whose runs fail says why without opening ``results.jsonl``);
+a plot of one figure against one swept parameter.
 
 Collisions decide success: an episode succeeded when its mission ended in SUCCESS *and* the
 simulator counted no collision (``ground_truth.collisions``); a SUCCESS that touched something is
@@ -15,6 +17,7 @@ from __future__ import annotations
 
 import json
 import statistics
+from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -28,6 +31,8 @@ NOT_FIGURES = frozenset({"id", "seed", "exit_code", "max_time_s"})
 HEADLINE = ("sim_time_s", "ground_truth.goal_error_m", "ground_truth.path_error_m", "ground_truth.trajectory_length_m",
             "safety.safety_stops", "ground_truth.min_clearance_m")
 """Figures the printed table shows when they exist (every figure is in summary.json)."""
+REASONS = 3
+"""The commonest reasons of failure kept per parameter combination."""
 COLLISIONS = "ground_truth.collisions"
 
 
@@ -40,6 +45,13 @@ def collided(row: Row) -> bool:
 def succeeded(row: Row) -> bool:
     """SUCCESS without a collision."""
     return row.get("status") == "SUCCESS" and not collided(row)
+
+
+def failure_reason(row: Row) -> str:
+    """Why an episode did not succeed: its reason, or that it collided although its mission succeeded."""
+    if row.get("status") == "SUCCESS":
+        return "the mission succeeded but the robot collided"
+    return str(row.get("reason") or row.get("error") or "no reason")
 
 
 def parameter_keys(rows: Sequence[Row]) -> list[str]:
@@ -58,7 +70,9 @@ def figure_keys(rows: Sequence[Row]) -> list[str]:
 def summarise(rows: Sequence[Row]) -> list[dict[str, Any]]:
     """One entry per parameter combination: its parameters, ``episodes``, ``success`` (SUCCESS
     without a collision), ``failure``, ``error``, ``collided`` (episodes with a collision, whatever
-    their status), ``success_rate`` and ``figures`` {name: {n, mean, std, min, max}}."""
+    their status), ``success_rate``, ``reasons`` (the commonest reasons of the runs that did not
+    succeed, ``[{reason, count}]``, most frequent first) and ``figures`` {name: {n, mean, std, min,
+    max}}."""
     params = parameter_keys(rows)
     figures = figure_keys(rows)
     groups: dict[str, list[Row]] = {}
@@ -74,6 +88,8 @@ def summarise(rows: Sequence[Row]) -> list[dict[str, Any]]:
                      error=len(members) - statuses.count("SUCCESS") - statuses.count("FAILURE"),
                      collided=sum(collided(m) for m in members))
         entry["success_rate"] = entry["success"] / len(members)
+        why = Counter(failure_reason(m) for m in members if not succeeded(m))
+        entry["reasons"] = [{"reason": reason, "count": count} for reason, count in why.most_common(REASONS)]
         entry["figures"] = {}
         for name in figures:
             values = [m[name] for m in members if is_number(m.get(name))]
@@ -99,7 +115,7 @@ def format_summary(summary: Sequence[dict[str, Any]], figures: Sequence[str] | N
     if not summary:
         return "no results"
     params = [k for k in summary[0] if k not in ("episodes", "success", "failure", "error", "collided", "success_rate",
-                                                 "figures")]
+                                                 "reasons", "figures")]
     varying = [k for k in params if len({json.dumps(e.get(k), default=str) for e in summary}) > 1]
     shown = varying or [k for k in params if summary[0].get(k) is not None][:2]
     present = sorted({name for e in summary for name in e["figures"]})
@@ -116,7 +132,19 @@ def format_summary(summary: Sequence[dict[str, Any]], figures: Sequence[str] | N
             cells.append(f"{stats['mean']:.3g} +- {stats['std']:.2g}" if stats else "-")
         lines.append(cells)
     widths = [max(len(line[i]) for line in lines) for i in range(len(header))]
-    return "\n".join("  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip() for line in lines)
+    table = "\n".join("  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip() for line in lines)
+    return table + _format_reasons(summary, shown)
+
+
+def _format_reasons(summary: Sequence[dict[str, Any]], shown: Sequence[str]) -> str:
+    """Under the table, per combination with failed runs: ``lab, 2: 8 x Drive failed: stalled``."""
+    lines = []
+    for entry in summary:
+        if entry.get("reasons"):
+            where = ", ".join(f"{_short(k)}={_cell(entry.get(k))}" for k in shown)
+            said = "; ".join(f"{r['count']} x {r['reason']}" for r in entry["reasons"])
+            lines.append(f"  {where}: {said}")
+    return "\n\nwhy runs did not succeed (commonest first):\n" + "\n".join(lines) if lines else ""
 
 
 def _full_name(name: str, present: Sequence[str]) -> str | None:

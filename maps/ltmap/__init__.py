@@ -1,4 +1,4 @@
-"""The Landmark-Tree map (LT-map) of a taught route: Jäger, Mair et al., IROS 2013 (DESIGN.md, algorithm 1).
+"""The Landmark-Tree map (LT-map) of a taught route: Jäger, Mair et al., IROS 2013 (docs/design.md, method 1).
 
 One concern per module; callers import from them (nothing is re-exported here):
 

@@ -1,6 +1,6 @@
 """Teaching an LT-map: :class:`RouteLearner` turns the observations of a driven route into a tree.
 
-Jäger, Mair et al., IROS 2013 (DESIGN.md, algorithm 1). Feed the learner every new observation
+Jäger, Mair et al., IROS 2013 (docs/design.md, method 1). Feed the learner every new observation
 with the camera's heading; it decides where viewframes are and hands the tree
 (:class:`maps.ltmap.tree.LandmarkTree`) what each one saw. How the paper is read here:
 

@@ -1,6 +1,6 @@
 """The LT-map itself: landmarks in a tree whose root-to-leaf branches are the viewframes of a route.
 
-Jäger, Mair et al., IROS 2013 (DESIGN.md, algorithm 1). A *landmark* is a descriptor (a binary
+Jäger, Mair et al., IROS 2013 (docs/design.md, method 1). A *landmark* is a descriptor (a binary
 ORB row, or the id of the simulator's ideal bearings sensor) with a unit bearing in the route
 frame (compensated for the robot's rotation, :func:`maps.ltmap.learner.compensate`). A
 *viewframe* is the set of landmarks seen from one place of a taught route: the union of the

@@ -19,6 +19,9 @@ COMMANDS = (
     "missions.commands.calibrate",
     "missions.commands.doctor",
     "missions.commands.map",
+    "missions.commands.plot",
+    "missions.commands.missions_list",
+    "missions.commands.log",
 )
 
 ENTRY_POINT_GROUP = "bearings.commands"

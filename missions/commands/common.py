@@ -46,8 +46,10 @@ def parse_sets(sets: list[str]) -> dict[str, str]:
     return out
 
 
-def load_from_args(path: str, args: argparse.Namespace) -> MissionSpec:
-    return load_mission(path, overrides=parse_sets(args.sets), search_path=args.search_path,
+def load_from_args(path: str, args: argparse.Namespace, *, to_run: bool = False) -> MissionSpec:
+    """The mission a command names, with its ``--set`` and ``--path``; ``to_run``: every required
+    input must be given."""
+    return load_mission(path, overrides=parse_sets(args.sets), search_path=args.search_path, require_inputs=to_run,
                         output_dir=getattr(args, "output_dir", None))
 
 

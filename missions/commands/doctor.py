@@ -42,32 +42,60 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if not 0.05 <= args.seconds <= 60:
         return fail("doctor", f"--seconds must be between 0.05 and 60, got {args.seconds:g}")
-    from missions.profiles import open_robot
+    from missions.profiles import load_profile
 
     try:
-        robot = open_robot(args.robot)
+        name, devices = load_profile(args.robot)
     except InputError as exc:
         return print_input_error(exc)
-    except OSError as exc:
-        print(f"bearings doctor: cannot open the robot: {exc}", file=sys.stderr)
-        return EXIT_FAILURE
     problems: list[str] = []
+    opened = _open_each(devices, problems)  # a device that does not open costs its own line, not the others'
+    base, ptu = opened.get("base"), opened.get("ptu")
+    cameras = {key.removeprefix("camera:"): handle for key, handle in opened.items() if key.startswith("camera:")}
     try:
-        print(f"robot {robot.name} ({args.robot})")
-        camera_lines = _watch_cameras(robot.cameras, args.seconds, problems)
-        _check(problems, "base", lambda: _report_base(robot.base))
-        if robot.ptu is not None:
-            _check(problems, "ptu", lambda: _report_ptu(robot.ptu))
+        print(f"robot {name} ({args.robot})")
+        camera_lines = _watch_cameras(cameras, args.seconds, problems)
+        if base is not None:
+            _check(problems, "base", lambda: _report_base(base))
+        if ptu is not None:
+            _check(problems, "ptu", lambda: _report_ptu(ptu))
         for line in camera_lines:
             print(line)
     finally:
-        robot.close()
+        _close(base, ptu, cameras)
     if problems:
         for problem in problems:
             print(f"bearings doctor: {problem}", file=sys.stderr)
         return EXIT_FAILURE
     print("OK: every device answered")
     return EXIT_OK
+
+
+def _open_each(devices: list[Any], problems: list[str]) -> dict[str, Any]:
+    """Open every device of the profile on its own: ``{"base": ..., "ptu": ..., "camera:front": ...}``."""
+    opened: dict[str, Any] = {}
+    for device in devices:
+        try:
+            handle = device.opener(device.settings, clock=None)
+        except Exception as exc:  # noqa: BLE001 - a device that cannot be opened is reported, the others checked
+            what = device.role if device.role != "camera" else f"camera {device.name}"
+            problems.append(f"{what}: cannot open the device: {exc}")
+            continue
+        opened[device.role if device.role != "camera" else f"camera:{device.name}"] = handle
+    return opened
+
+
+def _close(base: Any, ptu: Any, cameras: dict[str, Any]) -> None:
+    """Stop, then release what was opened (cameras, pan-tilt, base last), as a run ends."""
+    for device in (base, ptu):
+        stop = getattr(device, "halt" if device is ptu else "stop", None)
+        if callable(stop):
+            with contextlib.suppress(Exception):
+                stop()
+    for device in (*cameras.values(), ptu, base):
+        if device is not None:
+            with contextlib.suppress(Exception):  # keep closing the others
+                device.close()
 
 
 def _check(problems: list[str], what: str, report: Any) -> None:

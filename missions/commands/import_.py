@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from maps.store import InputError
 from missions.commands.common import emit, print_input_error
@@ -23,12 +24,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("tree", metavar="TREE.xml", help="BehaviorTree.CPP v4 XML file")
     parser.add_argument("-o", "--output", metavar="MISSION.yaml", help="write the mission to this file "
                         "(default: standard output)")
+    parser.add_argument("--plugin", dest="plugins", action="append", default=[], metavar="MODULE|FILE.py",
+                        help="a plugin whose node types the tree uses (repeatable): an installed module, or a .py "
+                             "file in the mission's folder; the mission lists it under plugins:")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    folder = Path(args.output).parent if args.output else Path.cwd()  # where the mission will find its plugins
     try:
-        text = import_btcpp(args.tree)
+        text = import_btcpp(args.tree, plugins=tuple(args.plugins), plugin_folder=folder)
     except InputError as exc:
         return print_input_error(exc)
     return emit("import", text, args.output, inputs=[args.tree])

@@ -1,6 +1,7 @@
-"""``bearings map``: inspect and prune saved maps (LT-maps of taught routes).
+"""``bearings map``: inspect and prune saved maps (LT-maps of taught routes, roadmaps).
 
-``info`` prints what the tree holds; ``prune`` cuts its lowest levels until it fits a memory
+``info`` prints what the tree holds (a roadmap's targets and edges: :mod:`missions.commands.map_roadmap`);
+``prune`` cuts its lowest levels until it fits a memory
 budget (LT-map paper: the first and last viewframe keep their landmarks, viewframes left with too
 few landmarks go) and writes the result atomically. Bad input is one line on stderr and exit 2,
 never a traceback; a budget the map cannot meet writes nothing.
@@ -13,11 +14,15 @@ import json
 import math
 import os
 import re
+from pathlib import Path
 
 from maps.ltmap.file import load_ltmap, save_ltmap
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
-from maps.store import InputError
+from maps.mapfile import read_map_file
+from maps.roadmap import Roadmap
+from maps.store import InputError, output_problem
 from missions.commands.common import EXIT_INVALID, EXIT_OK, fail
+from missions.commands.map_roadmap import draw_roadmap, print_roadmap, roadmap_info
 
 UNITS = {"": 1, "b": 1, "kb": 10**3, "mb": 10**6, "gb": 10**9, "kib": 2**10, "mib": 2**20, "gib": 2**30}
 MAX_BUDGET = 2**40  # 1 TiB: far above any map; a larger "budget" is a typo
@@ -25,7 +30,8 @@ _SIZE = re.compile(r"\s*(\d+(?:\.\d*)?|\.\d+)\s*([A-Za-z]*)\s*")
 
 DESCRIPTION = """Inspect and prune saved maps.
 
-  info   viewframes, landmarks, tree height, bytes, landmarks per tree level (root first)
+  info   an LT-map: viewframes, landmarks, tree height, bytes, landmarks per tree level (root first);
+         a roadmap: targets, edges with their motions and sigmas (--plot F.png draws them)
   prune  cut the lowest tree levels until the map fits a memory budget
 
 Bytes are the map's content as stored: per landmark its descriptor (or id) and bearing, per
@@ -61,13 +67,15 @@ def parse_byte_size(text: str) -> int:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    parser = sub.add_parser("map", help="inspect and prune saved maps (LT-maps)", description=DESCRIPTION,
+    parser = sub.add_parser("map", help="inspect and prune saved maps (LT-maps, roadmaps)", description=DESCRIPTION,
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     commands = parser.add_subparsers(dest="map_command", metavar="SUBCOMMAND")
     info = commands.add_parser("info", help="what a map holds", description="Print what an LT-map file holds: "
-                               "viewframes, landmarks, height, bytes and landmarks per level (root first).")
-    info.add_argument("file", metavar="FILE", help="an LT-map file")
+                               "viewframes, landmarks, height, bytes and landmarks per level (root first); or what "
+                               "a roadmap holds: targets, edges (motion, sigma_x, sigma_y, cost), connectivity.")
+    info.add_argument("file", metavar="FILE", help="an LT-map or roadmap file")
     info.add_argument("--json", action="store_true", help="print one JSON object")
+    info.add_argument("--plot", type=Path, metavar="F.png", help="a roadmap: also draw its targets and edges here")
     info.set_defaults(func=run_info)
     prune = commands.add_parser("prune", help="cut tree levels until a map fits a memory budget",
                                 description="Prune an LT-map to a memory budget and write the result atomically.",
@@ -89,9 +97,14 @@ def _help(parser: argparse.ArgumentParser) -> int:
 
 def run_info(args: argparse.Namespace) -> int:
     try:
+        kind = read_map_file(args.file).header.kind
+        if kind == "roadmap":
+            return _roadmap_info(args)
         tree = load_ltmap(args.file)
     except InputError as exc:
         return fail("map", str(exc.diagnostics[0]))
+    if args.plot is not None:
+        return fail("map", f"--plot draws a roadmap; {args.file} is an LT-map (bearings plot draws a run's viewframes)")
     summary = tree.summary()
     if args.json:
         print(json.dumps({"file": args.file, "landmark_kind": summary.kind, "viewframes": summary.viewframes,
@@ -111,6 +124,20 @@ def run_info(args: argparse.Namespace) -> int:
     print(args.file)
     for name, value in rows:
         print(f"  {name:<13}{value}")
+    return EXIT_OK
+
+
+def _roadmap_info(args: argparse.Namespace) -> int:
+    info = roadmap_info(Roadmap.load(args.file))
+    if args.plot is not None:
+        problem = output_problem(args.plot)
+        if problem:
+            return fail("map", f"cannot write {args.plot}: {problem}")
+        try:
+            draw_roadmap(info, args.plot)
+        except ImportError as exc:
+            return fail("map", str(exc))
+    print_roadmap(args.file, info, args.json)
     return EXIT_OK
 
 

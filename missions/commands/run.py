@@ -8,16 +8,22 @@ from pathlib import Path
 from typing import Any
 
 from behaviours.clock import TickClock
-from drivers.interfaces import Robot
+from drivers.interfaces import KeyboardOpener, Robot
+from drivers.keyboard import TerminalKeys
+from drivers.logs.camera_codec import parse_image_format
+from drivers.pioneer_body import BODIES
 from drivers.safety.settings import monitor_config
 from maps.located import validate
 from maps.store import Diagnostic, InputError, output_problem, write_json
-from missions.clocks import Paced, WallClock
+from missions.clocks import Paced, WallClock, paced_when_operated
 from missions.commands.common import add_mission_options, load_from_args, parse_pose, print_input_error
+from missions.images import DEFAULT_RATE_HZ
 from missions.model import RunArguments
 from missions.outputs import prepare_written_files
+from missions.progress import progress_for
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
+from missions.summary import summary_line
 from perception.collision_monitor import MonitorConfig
 from perception.geometry import Pose2D
 from perception.polygons import disc
@@ -26,7 +32,12 @@ DESCRIPTION = """Run a mission until its tree ends in SUCCESS or FAILURE.
 
 Without --robot the mission runs in the built-in simulator (--sim WORLD picks a shipped world by
 name or a world file; the default is an empty plane), as fast as the machine allows unless
---realtime is given. The same seed gives the same run, bit for bit.
+--realtime is given or an operator drives by keys (real time from when a key node first runs).
+The same seed gives the same run, bit for bit.
+
+--record F.mcap records every sensed input and command as ROS 2 messages (MCAP: Foxglove and the
+ROS 2 tools open it); --replay LOG runs the mission on such a recording, or on a ROS 2 or ROS 1
+bag, instead of a robot: open loop, its commands go nowhere (docs/recorded-data.md).
 
 Every command passes the collision monitor on its way to the base: it stops the robot short of
 what its range sensors see, slows it near obstacles, and crawls when they fall silent (the
@@ -51,6 +62,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     where.add_argument("--sim", metavar="WORLD", default=None,
                        help="simulate in WORLD (shipped name or world file; default: empty plane)")
     where.add_argument("--robot", metavar="ROBOT.yaml", help="run on the robot described by this profile")
+    where.add_argument("--replay", metavar="LOG", type=Path, help="play a log back as the robot: an MCAP file "
+                       "(--record writes one), a ROS 2 bag folder or a ROS 1 .bag (docs/recorded-data.md)")
+    parser.add_argument("--topics", metavar="MAP.yaml", type=Path,
+                        help="with --replay: which topics of the log are the odometry, cameras, ... (default: "
+                        "the names --record writes)")
+    parser.add_argument("--record", type=Path, metavar="F.mcap",
+                        help="record every sensed input and command as ROS 2 messages in MCAP (Foxglove, the ROS 2 "
+                        "tools and --replay read it); a missing folder is created")
+    parser.add_argument("--record-images", type=_image_format, default="jpeg", metavar="jpeg[:Q]|png",
+                        help="how --record compresses images: jpeg (quality 90, or Q) or png (lossless: a replay "
+                        "sees the very pixels); default jpeg")
     parser.add_argument("--seed", type=int, default=0, help="simulator seed, 0 to 4294967295 (default 0)")
     parser.add_argument("--start", metavar="POSE", help="simulator only: the robot's true start pose, x,y,theta "
                         "(theta in rad, or with a deg suffix) or a named pose of the world (default: its start)")
@@ -58,12 +80,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="write the run report (JSON) here; a missing folder is created")
     parser.add_argument("--save", type=Path, metavar="F.rrd",
                         help="record the run for the rerun viewer; a missing folder is created")
+    parser.add_argument("--image-rate", type=float, metavar="HZ", default=DEFAULT_RATE_HZ,
+                        help=f"camera images per second and camera in the --save recording, JPEG-encoded "
+                             f"(default {DEFAULT_RATE_HZ:g}; 0: every frame grabbed)")
     parser.add_argument("--max-time", type=float, metavar="S", help="FAILURE after S seconds (sim or wall time)")
     parser.add_argument("--rate", type=float, metavar="HZ", help="tick rate (default: the mission's, else 10)")
     parser.add_argument("--overrun", type=float, metavar="S",
                         help="how far a tick may overrun its period before the watchdog stops the base")
     parser.add_argument("--realtime", action="store_true", help="pace the simulator at wall-clock speed")
     parser.add_argument("--quiet", action="store_true", help="no progress line")
+    parser.add_argument("--progress", action="store_true",
+                        help="print progress even when stderr is not a terminal: a line every few seconds")
     parser.add_argument("--debug", action="store_true", help="print the traceback when a behaviour raises")
     add_mission_options(parser)
     parser.set_defaults(func=run)
@@ -74,9 +101,9 @@ def run(args: argparse.Namespace) -> int:
         try:
             numbers = _numbers(args)
             _prepare_outputs(args)
-            mission = load_from_args(args.mission, args)
+            mission = load_from_args(args.mission, args, to_run=True)
             prepare_written_files(mission, lambda note: print(f"bearings run: {note}", file=sys.stderr))
-            simulation, robot, clock, safety = _open(args, numbers.seed)
+            simulation, robot, clock, safety = _open(args, numbers.seed, mission)
         except InputError as exc:
             return print_input_error(exc)
         except DeviceUnavailable as exc:
@@ -100,51 +127,51 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
                                  f"{', '.join(robot.cameras) or 'none'})")]))
     options = RunOptions(
         rate_hz=numbers.rate, max_time_s=numbers.max_time, overrun_s=numbers.overrun, report_path=args.report,
-        save_path=args.save, progress=not args.quiet and sys.stderr.isatty(), seed=numbers.seed, debug=args.debug,
+        save_path=args.save, image_rate_hz=numbers.image_rate, seed=numbers.seed, debug=args.debug,
+        record_path=args.record, record_images=args.record_images,
     )  # fmt: skip
-    if args.realtime and simulation is not None:
-        clock = Paced(clock)
-    result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
-                    safety=safety).run()
-    clock_name = "sim" if simulation is not None else "wall"
+    keyboard: KeyboardOpener = TerminalKeys
+    if args.replay is not None:  # a replay's keyboard: the logged keys; its clock, paced when asked
+        keyboard = simulation.keyboard
+        if args.realtime:
+            clock = Paced(clock)
+    elif simulation is not None:  # real time when asked, or from when an operator takes the keyboard
+        clock = Paced(clock, engaged=args.realtime)
+        keyboard = paced_when_operated(TerminalKeys, clock, said=lambda line: print(line, file=sys.stderr))
+    progress = progress_for(mission.name, sys.stderr, asked=args.progress, quiet=args.quiet)
+    try:
+        result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
+                        on_tick=progress, keyboard=keyboard, safety=safety).run()
+    finally:
+        if progress is not None:
+            progress.close()
+    clock_name = {"sim_time": "sim", "replay_time": "log"}.get(clock.timeline, "wall")
     print(f"{mission.name}: {result.status} after {result.time_s:.1f} s {clock_name} time, {result.ticks} ticks "
           f"({result.reason})")
-    for line in outcome_lines(result.report):
-        print(line)
+    summary = summary_line(result.report)  # collisions, safety stops, clearance, each capability's headline
+    if summary:
+        print(summary)
     if args.report:
         print(f"report: {args.report}")
     if args.save:
         print(f"recording: {args.save} (open with: rerun {args.save})")
+    if args.record:
+        record = result.report.get("record", {})
+        print(f"sensor log: {args.record} ({record.get('messages', 0)} messages, {record.get('bytes', 0) / 1e6:.1f} MB;"
+              f" bearings log info {args.record})")
     return result.exit_code
 
 
-def outcome_lines(report: dict[str, Any]) -> list[str]:
-    """The lines after the status: the collision monitor's count, and the ground truth in simulation
-    (collisions and the true minimum clearance first: a run that touched something did not succeed)."""
-    safety = report.get("safety", {})
-    nearest = safety.get("min_range_m")
-    lines = [f"safety: {safety.get('safety_stops', 0)} stops, {safety.get('slowdowns', 0)} slow-downs, "
-             f"{safety.get('bumper_hits', 0)} bumper hits, nearest sensed "
-             f"{'nothing' if nearest is None else f'{nearest:.3f} m'} (sensors: {safety.get('sources', 'none')})"]
-    gt = report.get("ground_truth")
-    if gt:
-        figures = [f"collisions {gt.get('collisions', 0)}"]
-        if gt.get("min_clearance_m") is not None:
-            figures.append(f"min_clearance_m {gt['min_clearance_m']:.3f}")
-        figures += [f"{k} {gt[k]:.3f}" for k in ("trajectory_length_m", "goal_error_m", "path_error_m") if k in gt]
-        lines.append(f"ground truth: {', '.join(figures)}")
-    return lines
-
-
 def _numbers(args: argparse.Namespace) -> RunArguments:
-    given = {"--rate": args.rate, "--max-time": args.max_time, "--overrun": args.overrun, "--seed": args.seed}
+    given = {"--rate": args.rate, "--max-time": args.max_time, "--overrun": args.overrun, "--seed": args.seed,
+             "--image-rate": args.image_rate}
     return validate(RunArguments, {k: v for k, v in given.items() if v is not None}, file="command line")
 
 
 def _prepare_outputs(args: argparse.Namespace) -> None:
-    """Check --report and --save before anything runs; create a missing folder (and say so)."""
+    """Check --report, --save and --record before anything runs; create a missing folder (and say so)."""
     problems = []
-    for option, path in (("--report", args.report), ("--save", args.save)):
+    for option, path in (("--report", args.report), ("--save", args.save), ("--record", args.record)):
         if path is None:
             continue
         folder = path.resolve().parent
@@ -181,8 +208,21 @@ def _interrupted_early(args: argparse.Namespace, signum: int) -> int:
     return exit_code(signum)
 
 
-def _open(args: argparse.Namespace, seed: int) -> tuple[Any, Robot, TickClock, MonitorConfig]:
-    """(simulation or None, robot, the clock the run ticks on, the collision monitor's configuration)."""
+def _open(args: argparse.Namespace, seed: int, mission: Any) -> tuple[Any, Robot, TickClock, MonitorConfig]:
+    """(the run's observer: the simulation, the replay or None; the robot; the clock the run ticks on; the
+    collision monitor's configuration)."""
+    if args.topics is not None and args.replay is None:
+        raise InputError([Diagnostic("--topics", 0, 0, "maps the topics of a log: it goes with --replay LOG")])
+    if args.replay is not None:
+        from missions.log_check import open_replay
+
+        if args.start:
+            raise InputError([Diagnostic("--start", 0, 0, "sets the simulated robot's start; a replay starts where "
+                                         "the log does")])
+        if args.record is not None and args.record.resolve() == args.replay.resolve():
+            raise InputError([Diagnostic("--record", 0, 0, "would overwrite the log --replay reads")])
+        replay = open_replay(args.replay, args.topics, mission)  # exit 2 with what the log lacks
+        return replay, replay.robot, replay.clock(), monitor_config(None, BODIES["p3dx"].footprint)
     if args.robot:
         from missions.profiles import open_robot, robot_safety
 
@@ -224,3 +264,10 @@ def _start_pose(text: str | None, world: Any) -> Pose2D | None:
     if problem:
         raise InputError([Diagnostic("--start", 0, 0, f"the pose {problem}")])
     return pose
+
+
+def _image_format(text: str) -> Any:
+    try:
+        return parse_image_format(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 from py_trees.common import Status
 
 from behaviours.landmark_tree import LoadMap, PruneMap
@@ -39,6 +40,11 @@ def test_prune_map_to_a_fraction_reports_where_its_viewframes_came_from(tmp_path
     assert section["viewframe_source"][0] == 0 and section["viewframe_source"][-1] == tree.viewframe_count - 1
     assert tree.viewframe_count > pruned.viewframe_count  # the input map was not changed in place
     assert load_ltmap(tmp_path / "pruned.ltmap").viewframe_count == pruned.viewframe_count
+    # what was asked and what the nearest level cut gave are both said, at the end of the run too
+    assert section["memory_fraction_asked"] == pytest.approx(0.6, abs=1e-3)
+    assert f"{section['memory_fraction']:.1%} of the map for 60.0% asked" in harness.behaviour.feedback_message
+    headline = [f.name for f in harness.behaviour.figures() if f.headline]
+    assert headline == ["memory_fraction", "memory_fraction_asked"]
 
 
 def test_prune_map_fails_when_the_budget_cannot_be_met_and_passes_a_map_without_one():

@@ -74,7 +74,7 @@ def test_doctor_fails_with_the_reason(tmp_path, arcos, capsys):
     missing = _profile(tmp_path, str(tmp_path / "ttyUSB5"))
     assert main(["doctor", "--robot", str(missing), "--seconds", "0.1"]) == 1
     err = capsys.readouterr().err
-    assert "cannot open the robot" in err and "ttyUSB5" in err and "Traceback" not in err
+    assert "base: cannot open the device" in err and "ttyUSB5" in err and "Traceback" not in err
     base = arcos()
     bad = _profile(tmp_path, base.port, extra=", wheels: 4")
     assert main(["doctor", "--robot", str(bad)]) == 2
@@ -82,6 +82,15 @@ def test_doctor_fails_with_the_reason(tmp_path, arcos, capsys):
     base.estop = True
     assert main(["doctor", "--robot", str(_profile(tmp_path, base.port)), "--seconds", "0.1"]) == 0
     assert "warning: the motors are off" in capsys.readouterr().out
+
+
+def test_doctor_checks_every_device_when_one_does_not_open(tmp_path, ptu_emulator, capsys):
+    ptu = ptu_emulator()
+    profile = _profile(tmp_path, str(tmp_path / "ttyUSB5"), ptu.port)  # no base there, a pan-tilt unit here
+    assert main(["doctor", "--robot", str(profile), "--seconds", "0.1"]) == 1
+    captured = capsys.readouterr()
+    assert "base: cannot open the device" in captured.err and "ttyUSB5" in captured.err
+    assert "ptu: " in captured.out and "pan: now" in captured.out  # the pan-tilt unit was still checked
 
 
 def test_a_library_mission_runs_on_the_emulated_robot_and_leaves_it_stopped(tmp_path, arcos, ptu_emulator, capsys):

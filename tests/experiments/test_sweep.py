@@ -106,6 +106,23 @@ def test_summary_per_combination():
     assert table.splitlines()[0].split()[:2] == ["speed", "runs"] and "33%" in table and "goal_error_m" in table
 
 
+def test_the_summary_says_why_runs_did_not_succeed_commonest_first():
+    stalled = "Drive failed: stalled"
+    reasons = [stalled, stalled, "time limit of 60 s reached", None, stalled]
+    rows = [{"id": f"e{i}", "mission": "m", "world": "corridor", "seed": i, "max_time_s": None, "inputs.side": 2,
+             "status": "FAILURE", "reason": reason} for i, reason in enumerate(reasons)]
+    rows.append({"id": "ok", "mission": "m", "world": "lab", "seed": 0, "max_time_s": None, "inputs.side": 2,
+                 "status": "SUCCESS", "reason": "mission tree succeeded"})
+    corridor, lab = summarise(rows)
+    assert corridor["reasons"] == [{"reason": "Drive failed: stalled", "count": 3},
+                                   {"reason": "time limit of 60 s reached", "count": 1},
+                                   {"reason": "no reason", "count": 1}]
+    assert lab["reasons"] == []
+    table = format_summary([corridor, lab])
+    assert table.splitlines()[-1] == ("  world=corridor: 3 x Drive failed: stalled; 1 x time limit of 60 s reached; "
+                                      "1 x no reason")
+
+
 def test_a_success_that_collided_is_not_a_success():
     rows = [{"id": f"e{i}", "mission": "m", "world": "lab", "seed": i, "max_time_s": None, "status": "SUCCESS",
              "ground_truth.collisions": collisions, "safety.safety_stops": stops, "ground_truth.min_clearance_m": gap}
@@ -116,6 +133,7 @@ def test_a_success_that_collided_is_not_a_success():
     assert entry["figures"]["ground_truth.min_clearance_m"]["min"] == 0.0
     header = format_summary([entry]).splitlines()[0].split()
     assert {"collided", "safety_stops", "min_clearance_m"} <= set(header)
+    assert entry["reasons"] == [{"reason": "the mission succeeded but the robot collided", "count": 1}]
 
 
 # --------------------------------------------------------------------------------------------

@@ -34,6 +34,7 @@ from missions.btcpp import BUILTIN_NAMES, identifier_to_key, key_to_identifier, 
 from missions.cli import main
 from missions.export import btcpp_xml
 from missions.importer import dump_mission, import_btcpp
+from missions.inputs import Unbound
 from missions.language import NodeSpec
 from missions.loader import LIBRARY, load_mission
 from tests.fuzzing import examples
@@ -345,8 +346,10 @@ def shape(node: NodeSpec) -> tuple[Any, ...]:
 
 
 def round_trip(path: Path, folder: Path) -> tuple[Any, Any]:
-    """(original, imported) shapes of the task tree and the sense nodes; the export also loads in BT.CPP."""
-    mission = load_mission(path)
+    """(original, imported) shapes of the task tree and the sense nodes; the export also loads in BT.CPP.
+    Required inputs get a value, as to run (an export writes the values)."""
+    unbound = {name: "x" for name, value in load_mission(path).values.items() if isinstance(value, Unbound)}
+    mission = load_mission(path, overrides=unbound)
     xml_path = folder / f"{path.stem}.xml"
     xml = btcpp_xml(mission)
     load_in_btcpp(xml)

@@ -49,7 +49,8 @@ def test_help_lists_the_built_ins_then_the_entry_points_by_name(monkeypatch, plu
     entries = (_entry("zz", "bearings_hello_cmd"), _entry("bench", "experiments.commands.bench"))
     monkeypatch.setattr(cli, "command_entry_points", lambda: tuple(sorted(entries, key=lambda e: e.name)))
     names = _commands(cli.build_parser())
-    builtin = ["run", "validate", "show", "import", "schema", "sim", "calibrate", "doctor", "map"]
+    builtin = ["run", "validate", "show", "import", "schema", "sim", "calibrate", "doctor", "map", "plot", "missions",
+               "log"]
     assert names == [*builtin, "bench", "hello"]
 
 

@@ -21,9 +21,9 @@ from drivers.pioneer_body import BODIES
 from drivers.safety.settings import monitor_config
 from drivers.sim.simulation import Simulation
 from missions.cli import main
-from missions.commands.run import outcome_lines
 from missions.loader import load_mission
 from missions.runner import Runner, RunOptions
+from missions.summary import summary_line
 from perception.geometry import Pose2D
 from perception.polygons import disc
 from perception.ranges import RangeScan, RangeSensor
@@ -154,11 +154,12 @@ def test_the_tree_reads_the_monitors_state_and_the_recording_gets_an_event_line(
 def test_bearings_run_ends_with_the_collisions_the_stops_and_the_clearance(capsys):
     assert main(["run", "square", "--quiet"]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[1] == "safety: 0 stops, 0 slow-downs, 0 bumper hits, nearest sensed nothing (sensors: none)"
-    assert out[2].startswith("ground truth: collisions 0, trajectory_length_m ")
+    assert out[1].startswith("ground truth: collisions 0, goal error ")  # the empty world: no clearance to tell
+    assert "; safety: safety stops 0, slowdowns 0, bumper hits 0, " in out[1]
     report = {"safety": {"safety_stops": 2, "slowdowns": 1, "bumper_hits": 0, "min_range_m": 0.081,
                          "sources": "scene sonar (16 transducers)"},
-              "ground_truth": {"collisions": 0, "min_clearance_m": 0.0794, "trajectory_length_m": 1.2}}
-    assert outcome_lines(report) == [
-        "safety: 2 stops, 1 slow-downs, 0 bumper hits, nearest sensed 0.081 m (sensors: scene sonar (16 transducers))",
-        "ground truth: collisions 0, min_clearance_m 0.079, trajectory_length_m 1.200"]
+              "ground_truth": {"collisions": 0, "min_clearance_m": 0.0794, "trajectory_length_m": 1.2},
+              "headline": ["ground_truth.trajectory_length_m"]}
+    assert summary_line(report) == (
+        "ground truth: collisions 0, min clearance 0.079 m, trajectory length 1.200 m; safety: safety stops 2, "
+        "slowdowns 1, bumper hits 0, min range 0.081 m, sources scene sonar (16 transducers)")

@@ -80,7 +80,7 @@ def test_included_required_input_must_be_given(write_mission):
     path = write_mission("tree:\n  include: leg.yaml\n")
     with pytest.raises(InputError) as info:
         load_mission(path)
-    assert "input 'd' has no default and was not given" in str(info.value)
+    assert "input 'd' is required (the include's inputs: do not give it)" in str(info.value)
 
 
 def test_include_search_path_and_environment(write_mission, tmp_path, monkeypatch):

@@ -9,6 +9,7 @@ import numpy as np
 import py_trees
 
 from behaviours.telemetry import Arrows, Drawing, Event, Figure, Lines, Picture, Plot, Points
+from missions.images import ImageRate
 from missions.recording import Recorder
 
 
@@ -53,8 +54,8 @@ def test_every_drawing_becomes_its_archetype():
     recorder.log_node(_Node())
     kinds = {entity: kind for entity, kind, _ in fake.logged}
     assert kinds == {"figures/ltmap/search/scans": "Scalars", "a/points2d": "Points2D", "a/points3d": "Points3D",
-                     "a/lines": "LineStrips2D", "a/arrows": "Arrows2D", "a/picture": "Image", "a/events": "TextLog",
-                     "a/plot": "Scalars"}
+                     "a/lines": "LineStrips2D", "a/arrows": "Arrows2D", "a/picture": "EncodedImage",
+                     "a/events": "TextLog", "a/plot": "Scalars"}
     labels = next(kwargs["labels"] for entity, _, kwargs in fake.logged if entity == "a/points3d")
     assert labels == ["x", "y", "z"]
 
@@ -71,7 +72,7 @@ def test_a_figure_is_plotted_only_when_it_changes():
 
 def test_figures_are_gathered_at_most_once_a_second_of_the_run():
     recorder, fake = _recorder()
-    recorder._figures_at, recorder._last_status = float("-inf"), {}
+    recorder._figures_at, recorder._last_status, recorder.images = float("-inf"), {}, ImageRate()
     recorder.timeline = "sim_time"
     node = _Node()
     root = py_trees.behaviours.Success(name="root")

@@ -94,15 +94,14 @@ def test_goto_target_reaches_the_goal_through_the_graph(tmp_path):
     assert data["last_command"] == {"v": 0.0, "w": 0.0}
 
 
-def test_goto_target_without_a_target_name_fails_saying_so(tmp_path):
+def test_goto_target_without_a_target_name_stops_before_anything_moves(tmp_path, capsys):
     write_target_images("lab", ["door"], tmp_path)
     Roadmap().with_target("door", Pose2D(), "door.png").save(tmp_path / "r.roadmap")
     report = tmp_path / "r.json"
     code = run("run", "goto_target", "--sim", "lab", "--quiet", "--report", str(report),
                "--set", f"roadmap={tmp_path / 'r.roadmap'}")
-    assert code == 1
-    assert json.loads(report.read_text())["reason"] == ("NavigateToTarget failed: no target given (goto_target: "
-                                                         "--set target=NAME)")
+    assert code == 2 and not report.exists()  # the target input is declared required: refused at load
+    assert "input 'target' is required: give it with --set target=VALUE" in capsys.readouterr().err
 
 
 def test_learn_targets_then_goto_target_in_a_small_room(tmp_path, world_file):

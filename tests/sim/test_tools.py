@@ -61,7 +61,7 @@ def test_sim_worlds_lists_the_shipped_worlds(capsys) -> None:
         assert f"{name}:" in out
 
 
-def test_log_rerun_records_world_trajectories_images_and_view_direction(tmp_path: Path) -> None:
+def test_log_rerun_records_world_trajectories_and_view_direction(tmp_path: Path) -> None:
     import rerun as rr
 
     rec = rr.RecordingStream("bearings-test")
@@ -76,12 +76,12 @@ def test_log_rerun_records_world_trajectories_images_and_view_direction(tmp_path
         sim.step(0.1)
         if tick % 5 == 0:
             camera.grab()
-        sim.log_rerun(rec, image_every=5)
+        sim.log_rerun(rec)
     rec.flush()
     rec.disconnect()
-    assert path.stat().st_size > 100_000  # the images are in there
     logged = path.read_bytes()
-    entities = ["world/walls", "world/landmarks", "camera/panorama", "world/ground_truth/ptu_view"]
+    assert b"camera/panorama" not in logged  # images are the recorder's, from the frames the mission grabbed
+    entities = ["world/walls", "world/landmarks", "world/ground_truth/ptu_view"]
     entities += ["world/ground_truth/trajectory_true", "world/ground_truth/trajectory_odometry"]
     for entity in entities:
         assert entity.encode() in logged, entity
