@@ -22,7 +22,10 @@ the robot's odometry. Three phases:
   direction will do: stopped.
 
 Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
-without a direction, for ``timeout`` seconds ("blocked for 20 s by an obstacle 0.40 m ahead"), a
+without a direction, for ``timeout`` seconds (a hold the motion node's ending cut short, a route
+follower losing the trail for a moment, goes on counting when the node starts again within
+:data:`RESTART_GAP` where the robot stood: otherwise a node that fails and is restarted every
+few seconds in front of a person would hold the robot for ever) ("blocked for 20 s by an obstacle 0.40 m ahead"), a
 detour longer than ``max_length`` metres that has not got past, or one that has turned by
 :data:`GOING_ROUND` (180 degrees): it is going round the obstacle, because what the motion node
 heads for is behind it or in it (a person standing where a viewframe was taught).
@@ -46,6 +49,8 @@ from perception.polygons import distance
 
 Phase = Literal["clear", "waiting", "detour"]
 GOING_ROUND = math.pi  # rad: a detour that has turned this much is going round the obstacle, not past it
+RESTART_GAP = 2.0  # s: a hold cut short by the node's ending goes on when held again this soon ...
+STOOD = 0.05  # m: ... this close to where it was held
 
 
 @dataclass(frozen=True, slots=True)
@@ -91,6 +96,7 @@ class _Episode:
 
     since: float  # when the robot was first held
     line: DetourLine
+    origin: float  # when the hold began, for the wait and the timeout: since, or a cut hold's (_held_since)
     detour_start: float | None = None
     length: float = 0.0
     turned: float = 0.0  # rad, signed: the heading's change since the detour started
@@ -111,6 +117,8 @@ class Avoidance:
         self.tally = Tally()
         self.phase: Phase = "clear"
         self._episode: _Episode | None = None
+        self._pose: Pose2D | None = None  # the last tick's
+        self._cut: tuple[float, float, Pose2D] | None = None  # a hold that reset cut short: (since, when, where)
 
     @property
     def line(self) -> DetourLine | None:
@@ -122,6 +130,7 @@ class Avoidance:
         """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
         robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command."""
         around = Surroundings.of(points, self.avoid)
+        self._pose = pose
         episode = self._episode
         if episode is not None and episode.detour_start is not None:
             return self._detour(episode, v, w, around, pose, now, stopped)
@@ -140,6 +149,9 @@ class Avoidance:
     def reset(self, now: float) -> None:
         """End whatever is going on (the motion node ended or was halted), tallying it as it is."""
         episode = self._episode
+        held = None if episode is None else episode.held_since if episode.detour_start is not None else \
+            None if self.phase == "clear" else episode.origin
+        self._cut = None if held is None or self._pose is None else (held, now, self._pose)
         if episode is not None:
             if episode.detour_start is not None:
                 self._end_detour(episode, now)
@@ -158,7 +170,7 @@ class Avoidance:
         episode = self._episode
         resumed = episode is not None and episode.clear_since is not None
         if episode is None or not resumed:
-            episode = self._episode = _Episode(now, DetourLine.at(pose))
+            episode = self._episode = _Episode(now, DetourLine.at(pose), self._held_since(pose, now))
             self.tally.waits += 1
         episode.clear_since = None
         episode.by_monitor = episode.by_monitor or by_monitor
@@ -168,7 +180,7 @@ class Avoidance:
 
     def _wait(self, episode: _Episode, v: float, w: float, around: Surroundings, pose: Pose2D, now: float
               ) -> Decision:
-        held = now - episode.since
+        held = now - episode.origin
         if held < self.settings.wait:
             return Decision(0.0, 0.0, "waiting")
         choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v), pose=pose,
@@ -222,8 +234,19 @@ class Avoidance:
         episode.side = episode.side or choice.side
         return Decision(*steer(choice, around, self.avoid), "detour", choice)
 
+    def _held_since(self, pose: Pose2D, now: float) -> float:
+        """When a new hold began: now, or when a hold cut short by the node's ending began, if the
+        robot is held again soon after where it stood (module docstring)."""
+        cut, self._cut = self._cut, None
+        if cut is None:
+            return now
+        since, when, where = cut
+        near = math.hypot(pose.x - where.x, pose.y - where.y) <= STOOD
+        return since if near and now - when <= RESTART_GAP else now
+
     def _give_up(self, reason: str, now: float) -> Decision:
         self.reset(now)
+        self._cut = None
         self.tally.give_ups += 1
         self.tally.reasons.append(reason)
         return Decision(0.0, 0.0, "clear", event=f"gave up: {reason}", gave_up=reason)

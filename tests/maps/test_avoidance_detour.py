@@ -86,6 +86,25 @@ def test_boxed_in_it_gives_up_after_the_timeout_with_the_reason():
     assert a.tally.give_ups == 1 and a.tally.reasons == [gave_up.gave_up] and a.phase == "clear"
 
 
+def test_a_hold_cut_short_by_the_nodes_ending_goes_on_counting_where_the_robot_stood():
+    # a route follower that loses the trail for a moment in front of a person ends and starts again
+    a = avoidance(wait=2.0, timeout=5.0)
+    a.step(0.3, 0.0, BOXED_IN, HERE, 0.0)
+    a.reset(1.5)
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 1.7).event == "the way is blocked 0.19 m ahead: waiting"
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 4.9).gave_up == ""
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 5.0).gave_up.startswith("blocked for 5 s by an obstacle")
+    assert a.tally.waits == 2 and a.tally.wait_time == pytest.approx(1.5 + 3.3)  # each hold once
+    b = avoidance(wait=2.0, timeout=5.0)  # held again elsewhere, or later: a new hold
+    b.step(0.3, 0.0, BOXED_IN, HERE, 0.0)
+    b.reset(1.5)
+    b.step(0.3, 0.0, BOXED_IN, Pose2D(0.1, 0.0, 0.0), 1.7)
+    assert b.step(0.3, 0.0, BOXED_IN, Pose2D(0.1, 0.0, 0.0), 6.6).gave_up == ""
+    b.reset(6.6)
+    b.step(0.3, 0.0, BOXED_IN, Pose2D(0.1, 0.0, 0.0), 9.0)
+    assert b.step(0.3, 0.0, BOXED_IN, Pose2D(0.1, 0.0, 0.0), 13.0).gave_up == ""
+
+
 def test_a_detour_that_would_stray_too_far_holds_and_gives_up_saying_so():
     a = avoidance(wait=0.0, timeout=5.0)
     assert a.step(0.3, 0.0, PERSON, HERE, 0.0).phase == "waiting"
