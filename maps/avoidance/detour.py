@@ -225,14 +225,15 @@ class Avoidance:
         episode.clear_since = None
         choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v),
                         side=episode.side, pose=pose, line=episode.line)
-        if choice.direction is not None and not stopped:
+        command = steer(choice, around, self.avoid)
+        if choice.direction is not None and not stopped and command != (0.0, 0.0):
             episode.held_since = None
-        else:  # no direction will do, or the monitor stopped the last command: held
+        else:  # no direction will do, none that moves the robot, or the monitor stopped the last command: held
             episode.held_since = now if episode.held_since is None else episode.held_since
             if now - episode.held_since >= self.settings.timeout:
                 return self._give_up(self._blocked_reason(now - episode.held_since, v, w, around.points, choice), now)
         episode.side = episode.side or choice.side
-        return Decision(*steer(choice, around, self.avoid), "detour", choice)
+        return Decision(*command, "detour", choice)
 
     def _held_since(self, pose: Pose2D, now: float) -> float:
         """When a new hold began: now, or when a hold cut short by the node's ending began, if the

@@ -105,6 +105,15 @@ def test_a_hold_cut_short_by_the_nodes_ending_goes_on_counting_where_the_robot_s
     assert b.step(0.3, 0.0, BOXED_IN, Pose2D(0.1, 0.0, 0.0), 13.0).gave_up == ""
 
 
+def test_a_detour_whose_command_does_not_move_the_robot_is_held_and_times_out(monkeypatch):
+    a = avoidance(wait=0.0, timeout=5.0)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.1).phase == "detour"
+    monkeypatch.setattr("maps.avoidance.detour.steer", lambda *_: (0.0, 0.0))  # a direction, but no motion to it
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.2).gave_up == ""
+    assert a.step(0.3, 0.0, PERSON, HERE, 5.2).gave_up.startswith("blocked for 5 s by an obstacle")
+
+
 def test_a_detour_that_would_stray_too_far_holds_and_gives_up_saying_so():
     a = avoidance(wait=0.0, timeout=5.0)
     assert a.step(0.3, 0.0, PERSON, HERE, 0.0).phase == "waiting"
