@@ -93,6 +93,7 @@ class AvoidObstacles(BearingsDecorator):
                               doc="the command the child wrote this tick (its wish)")
     RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path), doc=RANGES_KEY.doc)
     SAFETY = InputPort("safety", SafetyState, Ref(SAFETY_KEY.path), doc=SAFETY_KEY.doc)
+    RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
     PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, MEMORY,
              ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND)
 
