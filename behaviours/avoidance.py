@@ -85,6 +85,8 @@ class AvoidObstacles(BearingsDecorator):
                           doc="a detour keeps within this of the line the robot was on when it was held")
     MAX_DETOUR = InputPort("max_detour", float, 6.0, unit="m", minimum=0.1, maximum=1000.0, literal_only=True,
                            doc="a detour this long that has not got past: FAILURE")
+    PASS_TURNS = InputPort("pass_turns", bool, False, literal_only=True,
+                           doc="a wish to turn on the spot passes in every phase (a child turning by a measured angle)")
     MEMORY = InputPort("memory", float, 1.0, unit="s", minimum=0.0, maximum=10.0, literal_only=True,
                        doc="range echoes are remembered this long (odometry frame)")
     ROBOT_RADIUS = InputPort("robot_radius", float, 0.26, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
@@ -94,7 +96,7 @@ class AvoidObstacles(BearingsDecorator):
     RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path), doc=RANGES_KEY.doc)
     SAFETY = InputPort("safety", SafetyState, Ref(SAFETY_KEY.path), doc=SAFETY_KEY.doc)
     RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
-    PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, MEMORY,
+    PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, PASS_TURNS, MEMORY,
              ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
@@ -105,7 +107,7 @@ class AvoidObstacles(BearingsDecorator):
             turn_rate=math.radians(self.get_input(self.TURN_RATE)), max_stray=self.get_input(self.MAX_STRAY))
         self.avoidance = Avoidance(self.settings, DetourSettings(
             wait=self.get_input(self.WAIT), timeout=self.get_input(self.TIMEOUT),
-            max_length=self.get_input(self.MAX_DETOUR)))
+            max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS)))
         self.memory = ObstacleMemory(self.get_input(self.MEMORY))
         self.decision: Decision | None = None
         self._events: list[str] = []

@@ -19,7 +19,9 @@ the robot's odometry. Three phases:
   path by itself. A wish to stop or to back away passes (the collision monitor judges it). Where
   the wish heads is kept in the odometry frame from its last forward command, so that a wish to
   turn on the spot (which says only which way) does not swing the choice as the robot turns. No
-  direction will do: stopped.
+  direction will do: stopped. With ``pass_turns`` a wish to turn on the spot passes in every
+  phase: a node that turns by a measured angle (the roadmap's random moves and scans) fails when
+  its turn does not happen.
 
 Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
 without a direction, for ``timeout`` seconds (a hold the motion node's ending cut short, a route
@@ -61,6 +63,7 @@ class DetourSettings:
     timeout: float = 20.0  # s held (waiting, or on a detour with no direction) before giving up
     clear_time: float = 1.0  # s the way must stay clear to end a wait or a detour
     max_length: float = 6.0  # m: a detour this long that has not got past gives up
+    pass_turns: bool = False  # a wish to turn on the spot passes in every phase (nodes that turn by a measured angle)
 
 
 @dataclass(frozen=True, slots=True)
@@ -129,6 +132,8 @@ class Avoidance:
              stopped: bool = False) -> Decision:
         """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
         robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command."""
+        if self.settings.pass_turns and v == 0.0 and w != 0.0:  # the monitor judges a turn on the spot
+            return Decision(v, w, self.phase, passed=True)
         around = Surroundings.of(points, self.avoid)
         self._pose = pose
         episode = self._episode

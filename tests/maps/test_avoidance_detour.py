@@ -21,7 +21,7 @@ BOXED_IN = np.array([[0.45 * np.cos(a), 0.45 * np.sin(a)] for a in np.linspace(-
 HERE = Pose2D()
 
 
-def avoidance(**detour: float) -> Avoidance:
+def avoidance(**detour: float | bool) -> Avoidance:
     return Avoidance(AvoidSettings(disc(0.26)), DetourSettings(**detour))
 
 
@@ -112,6 +112,19 @@ def test_a_detour_whose_command_does_not_move_the_robot_is_held_and_times_out(mo
     monkeypatch.setattr("maps.avoidance.detour.steer", lambda *_: (0.0, 0.0))  # a direction, but no motion to it
     assert a.step(0.3, 0.0, PERSON, HERE, 0.2).gave_up == ""
     assert a.step(0.3, 0.0, PERSON, HERE, 5.2).gave_up.startswith("blocked for 5 s by an obstacle")
+
+
+def test_with_pass_turns_a_turn_on_the_spot_passes_while_waiting_and_on_a_detour():
+    a = avoidance(wait=0.0, pass_turns=True)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    assert a.phase == "waiting" and a.step(0.0, 0.5, PERSON, HERE, 0.1).passed
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.2).phase == "detour"
+    turn = a.step(0.0, -0.5, PERSON, HERE, 0.3)
+    assert turn.passed and (turn.v, turn.w, turn.phase) == (0.0, -0.5, "detour")
+    steered = avoidance(wait=0.0)  # without it, the detour steers a turn wish to its own direction
+    steered.step(0.3, 0.0, PERSON, HERE, 0.0)
+    steered.step(0.3, 0.0, PERSON, HERE, 0.1)
+    assert not steered.step(0.0, -0.5, PERSON, HERE, 0.2).passed
 
 
 def test_a_detour_that_would_stray_too_far_holds_and_gives_up_saying_so():
