@@ -47,7 +47,8 @@ BUILTIN_MODULES = (
     *(f"behaviours.roadmap.{m}" for m in ("targets", "calibration", "room", "coverage", "travel", "scan", "homing",
                                           "graph", "navigate")),
     # exploration with the stereo pair on the pan-tilt unit
-    *(f"behaviours.exploration.{m}" for m in ("localise", "map_stereo", "select_goal", "follow_path", "gaze")),
+    *(f"behaviours.exploration.{m}" for m in ("localise", "map_stereo", "select_goal", "follow_path", "gaze",
+                                              "look_around")),
 )  # fmt: skip
 _MARK = "__bearings_node_type__"
 

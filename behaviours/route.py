@@ -38,13 +38,18 @@ How the paper is read here (where it is vague):
   (:func:`perception.viewframe_motion.zinf_motion`; the module doc says why).
 - **Goal.** The switch rule fires within some radius of a viewframe (where ``delta_t`` first falls
   under the threshold), which is right for passing through viewframes but leaves the robot short
-  of the route's end: the last viewframe is reached under ``goal_fraction`` (a quarter) of the
-  threshold, or by the flip rule when the robot passes it.
+  of the route's end: the last viewframe is reached under the eq. 1 cost of ``goal_fraction``
+  (0.34) of the threshold's bearing change (1 deg of the default 3 deg), or by the flip rule
+  when the robot passes it. Fractions are taken of the bearing change, not of the cost
+  (:func:`perception.similarity.scaled`): eq. 1 is quartic near 0, so a quarter of the cost
+  would be 0.7 of the change. Eq. 1 weighs changes under 2 deg very little, so the goal needs
+  1 deg where the earlier angle form's quarter threshold stood for 1.35 deg (measured outdoors,
+  ``docs/ltmap.md``: the goal error 0.59 m instead of 0.67 m; the lab's is 0.04 m either way).
 - **Flip rule.** The filtered direction to the target is compared with the previous one for the
   same target; a change of more than ``flip_angle`` is a flip. It counts only near the viewframe
-  (``delta_t`` under ``flip_near`` times the threshold): outdoors, with few near landmarks, the
-  direction is noisy metres away from a viewframe, and a flip there is noise, not a passed
-  viewframe.
+  (``delta_t`` under the cost of ``flip_near`` = 2.7 times the threshold's bearing change, 8 deg
+  as before): outdoors, with few near landmarks, the direction is noisy metres away from a
+  viewframe, and a flip there is noise, not a passed viewframe.
 """
 
 from __future__ import annotations
@@ -69,12 +74,23 @@ from perception.geometry import wrap_angle
 from perception.heading import HeadingFilter, heading_flipped, scaled_velocity
 from perception.matching import LandmarkMatches
 from perception.observation import Observation
-from perception.similarity import delta_t
-from perception.viewframe_motion import ZINF_MIN_LANDMARKS, compass_motion, lost_threshold, zinf_motion
+from perception.similarity import scaled
+from perception.viewframe_motion import (
+    COMPASS,
+    RULES,
+    ZINF_MIN_LANDMARKS,
+    RuledMotion,
+    change_since,
+    compass_motion,
+    lost_threshold,
+    zinf_motion,
+)
 
 PROGRESS_KEY = "/map/route_progress"
 ESTIMATE_KEY = "/map/route_estimate"
 DIRECTIONS = ("forward", "reverse")
+NO_ROTATION, LOST = "no_rotation", "lost"
+ESTIMATE_RULES = (*RULES, NO_ROTATION, LOST)  # how FollowRoute counts its estimates (report: ltmap.estimates)
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,9 +139,10 @@ class RouteEstimate:
 
     ``heading``: eqs. 7-8, the filtered direction to the viewframe in the viewframe's frame
     (rad, NaN before the first estimate); ``error``: the same relative to the robot's heading,
-    what steering turns by (NaN when unknown); ``delta_t``: eq. 1 against the viewframe (rad^2,
-    inf without a rotation); ``status``: Z-infinity's (``perception.zinf.ZinfStatus``) or
-    ``"lost"`` when too few landmarks matched.
+    what steering turns by (NaN when unknown); ``delta_t``: eq. 1 against the viewframe (inf
+    without a rotation); ``status``: Z-infinity's (``perception.zinf.ZinfStatus``) or ``"lost"``
+    when too few landmarks matched; ``rule``: what made the rotation (a rung of Z-infinity's
+    ladder or the compass, ``perception.viewframe_motion.RULES``; empty when lost).
     """
 
     viewframe: int
@@ -136,6 +153,7 @@ class RouteEstimate:
     heading: float
     error: float
     confidence: float
+    rule: str = ""
 
     @property
     def usable(self) -> bool:
@@ -175,6 +193,13 @@ OBSERVATION_IN = InputPort("observation", Observation, Ref("/perception/observat
                            doc="the landmarks seen now (Perceive)")
 
 
+def _counted_as(estimate: RouteEstimate) -> str:
+    """The rule an estimate is counted under: its own when it found a rotation."""
+    if estimate.status == LOST:
+        return LOST
+    return estimate.rule if math.isfinite(estimate.delta_t) else NO_ROTATION
+
+
 @register
 class FollowRoute(BearingsBehaviour):
     """Home to the target viewframe with Z-infinity: filtered heading, confidence-scaled speed.
@@ -206,6 +231,7 @@ class FollowRoute(BearingsBehaviour):
         super().__init__(name=name, **ports)
         self.matches: LandmarkMatches | None = None  # the latest, for the recording
         self.estimate: RouteEstimate | None = None
+        self.rules = dict.fromkeys(ESTIMATE_RULES, 0)  # estimates by the rule that made them, over the run
         self._rng = np.random.default_rng(0)
         self._reset()
 
@@ -237,6 +263,7 @@ class FollowRoute(BearingsBehaviour):
         if observation.stamp != self._stamp:  # a new observation: a new estimate and command
             self._stamp = observation.stamp
             self.estimate = self._estimate(tree, progress.target, observation)
+            self.rules[_counted_as(self.estimate)] += 1
             self.set_output(self.ESTIMATE, self.estimate)
             self._command = self._steer(self.estimate)
         return self._lost_or_follow()
@@ -269,25 +296,26 @@ class FollowRoute(BearingsBehaviour):
         needed = lost_threshold(len(tree.viewframe(target)), self.get_input(MIN_MATCHES))
         nan = float("nan")
         if len(matches) < needed:
-            return RouteEstimate(target, observation.stamp, len(matches), "lost", math.inf, nan, nan, 0.0)
-        if self.get_input(self.ROTATION) == "compass":
-            motion, fallback = compass_motion(matches.ref, matches.cur, self._rng), False
+            return RouteEstimate(target, observation.stamp, len(matches), LOST, math.inf, nan, nan, 0.0)
+        chosen = self.get_input(self.ROTATION) == COMPASS  # the compass asked for, not as the last resort
+        if chosen:
+            ruled = RuledMotion(compass_motion(matches.ref, matches.cur, self._rng), COMPASS)
         else:
-            motion, fallback = zinf_motion(matches.ref, matches.cur, self._rng)  # eqs. 2-6
-        status = f"compass, {motion.status.value}" if fallback else motion.status.value
+            ruled = zinf_motion(matches.ref, matches.cur, self._rng)  # eqs. 2-6
+        motion, rule = ruled.motion, ruled.rule
+        status = f"compass, {motion.status.value}" if ruled.compass and not chosen else motion.status.value
         if not motion.rotation_ok:
-            return RouteEstimate(target, observation.stamp, len(matches), status, math.inf, nan, nan, 0.0)
-        weights = motion.inliers.astype(np.float64) if motion.inliers.any() else None
-        change = delta_t(matches.ref, matches.cur, rotation=motion.rotation, weights=weights)  # eq. 1
+            return RouteEstimate(target, observation.stamp, len(matches), status, math.inf, nan, nan, 0.0, rule)
+        change = change_since(matches.ref, matches.cur, motion, tree.scale)  # eq. 1 over the inliers
         if motion.ok:
             home = -motion.translation  # towards the viewframe, in its frame
             self._filter = self._filter.push(math.atan2(home[1], home[0]), motion.confidence)
         heading = self._filter.heading  # eqs. 7-8: circular median of the last K
         if heading is None:
-            return RouteEstimate(target, observation.stamp, len(matches), status, change, nan, nan, 0.0)
+            return RouteEstimate(target, observation.stamp, len(matches), status, change, nan, nan, 0.0, rule)
         error = wrap_angle(heading + motion.yaw)  # the robot's heading in the viewframe's frame is -yaw
         return RouteEstimate(target, observation.stamp, len(matches), status, change, heading, error,
-                             self._filter.confidence)
+                             self._filter.confidence, rule)
 
     def _steer(self, estimate: RouteEstimate) -> VelocityCommand:
         if not estimate.usable:
@@ -300,6 +328,12 @@ class FollowRoute(BearingsBehaviour):
                                 min_confidence=self.get_input(self.MIN_CONFIDENCE))  # eq. 9
         v = max(self.get_input(self.MIN_SPEED), speed) * math.cos(error)
         return VelocityCommand(v, w)
+
+    def figures(self) -> Iterator[Figure]:
+        """Every estimate counted by the rule that made it (``estimates.zinf_1deg`` ..
+        ``estimates.compass``), or as ``no_rotation`` (no rule found one) or ``lost`` (too few matches)."""
+        for rule, count in self.rules.items():
+            yield Figure("ltmap", f"estimates.{rule}", count)
 
     def drawings(self) -> Iterator[Drawing]:
         """While following: the target, matches, ``delta_t`` (capped at 1) and confidence as plots,
@@ -331,14 +365,16 @@ class ViewframeSwitch(BearingsBehaviour):
     Reports every switch (viewframe, time, rule) in the ``ltmap`` section.
     """
 
-    THRESHOLD = InputPort("threshold", float, 0.0, unit="rad^2", minimum=0.0,
+    THRESHOLD = InputPort("threshold", float, 0.0, minimum=0.0,
                           doc="eq. 1 switch threshold; 0: the one the map was taught with")
-    GOAL_FRACTION = InputPort("goal_fraction", float, 0.25, minimum=0.01, maximum=1.0,
-                              doc="the route's last viewframe is reached under this fraction of the threshold")
+    GOAL_FRACTION = InputPort("goal_fraction", float, 0.34, minimum=0.01, maximum=1.0,
+                              doc="the route's last viewframe is reached under the eq. 1 cost of this fraction "
+                                  "of the threshold's bearing change")
     FLIP_ANGLE = InputPort("flip_angle", float, 90.0, unit="deg", minimum=1.0, maximum=180.0,
                            doc="a change of the direction to the target larger than this: it was passed")
-    FLIP_NEAR = InputPort("flip_near", float, 4.0, minimum=1.0,
-                          doc="a flip counts only while delta_t is under this many thresholds (near the viewframe)")
+    FLIP_NEAR = InputPort("flip_near", float, 2.7, minimum=1.0,
+                          doc="a flip counts only while delta_t is under the eq. 1 cost of this many times the "
+                              "threshold's bearing change (near the viewframe)")
     ESTIMATE = InputPort("estimate", RouteEstimate, Ref(ESTIMATE_KEY), doc="the latest estimate (FollowRoute)")
     ADVANCED = OutputPort("advanced", RouteProgress, PROGRESS_KEY, doc="the progress after a switch")
     PORTS = (THRESHOLD, GOAL_FRACTION, FLIP_ANGLE, FLIP_NEAR, TURN_RATE, LTMAP_IN, PROGRESS_IN, ODOMETRY, ESTIMATE,
@@ -371,7 +407,7 @@ class ViewframeSwitch(BearingsBehaviour):
         if self._last is None or self._last[0] != progress.target:
             self._heading = None
         self._last = (estimate.viewframe, estimate.stamp)
-        rule = self._rule(estimate, progress, self.get_input(self.THRESHOLD) or tree.threshold)
+        rule = self._rule(estimate, progress, self.get_input(self.THRESHOLD) or tree.threshold, tree.scale)
         if math.isfinite(estimate.heading):
             self._heading = estimate.heading
         self.feedback_message = f"target {progress.target}, delta_t {estimate.delta_t:.2g}"
@@ -387,13 +423,13 @@ class ViewframeSwitch(BearingsBehaviour):
         self._heading = None
         return Status.SUCCESS if advanced.finished else Status.RUNNING
 
-    def _rule(self, estimate: RouteEstimate, progress: RouteProgress, threshold: float) -> str | None:
+    def _rule(self, estimate: RouteEstimate, progress: RouteProgress, threshold: float, scale: float) -> str | None:
         if progress.remaining == 1:  # the goal: home closer than the switching radius of the others
-            threshold *= self.get_input(self.GOAL_FRACTION)
+            threshold = scaled(threshold, self.get_input(self.GOAL_FRACTION), scale)
         if estimate.delta_t < threshold:  # eq. 1 under the threshold: at the viewframe
             return "delta_t"
         blocked = self.now() - progress.switched_at < self.block_time
-        far = estimate.delta_t >= self.get_input(self.FLIP_NEAR) * threshold
+        far = estimate.delta_t >= scaled(threshold, self.get_input(self.FLIP_NEAR), scale)
         if blocked or far or self._heading is None or not math.isfinite(estimate.heading):
             return None
         limit = math.radians(self.get_input(self.FLIP_ANGLE))

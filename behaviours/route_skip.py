@@ -39,7 +39,7 @@ def sees(tree: LandmarkTree, index: int, observation: Observation, min_matches: 
     matches = tree.match(index, observation)
     if len(matches) < lost_threshold(len(tree.viewframe(index)), min_matches):
         return False
-    return zinf_motion(matches.ref, matches.cur, rng)[0].rotation_ok
+    return zinf_motion(matches.ref, matches.cur, rng).motion.rotation_ok
 
 
 @register

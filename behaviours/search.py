@@ -122,7 +122,7 @@ class SearchPattern(BearingsBehaviour):
             matches = tree.match(index, observation)
             if len(matches) < lost_threshold(len(tree.viewframe(index)), self.get_input(MIN_MATCHES)):
                 continue
-            if zinf_motion(matches.ref, matches.cur, self._rng)[0].rotation_ok:
+            if zinf_motion(matches.ref, matches.cur, self._rng).motion.rotation_ok:
                 self.set_output(self.FOUND, progress.retargeted(index, self.now()))
                 self.found_again += 1
                 self.feedback_message = f"the trail is found again at viewframe {index}"

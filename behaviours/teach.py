@@ -11,7 +11,11 @@ saved: a file on disk is always a route that was driven to its end.
 
 The map is on ``/map/ltmap`` from the first viewframe on. The report's ``ltmap`` section holds
 the map's figures and, per viewframe, the tree time it was made (``taught``); an evaluation
-turns those times into places with the simulator's ground-truth trajectory.
+turns those times into places with the simulator's ground-truth trajectory. With gap filling
+(``gap_filling``, :mod:`maps.ltmap.gaps`) it also counts the landmarks found again and shifted
+to a common node (``shifted``) and lists the loops the route closed (``loops``: the viewframe
+pair, as taught, and the landmarks shared; ``loop_closures``: how many stretches of route came
+back past earlier places, consecutive viewframes with a loop counting once).
 """
 
 from __future__ import annotations
@@ -48,24 +52,31 @@ class LearnRoute(BearingsDecorator):
 
     PATH = InputPort("path", str, "", literal_only=True, file=WRITES,
                      doc="the LT-map file written at the end; empty: not saved")
-    THRESHOLD = InputPort("threshold", float, DEFAULT_THRESHOLD, unit="rad^2", minimum=1e-9, literal_only=True,
-                          doc="eq. 1: a new viewframe when delta_t passes it")
+    THRESHOLD = InputPort("threshold", float, DEFAULT_THRESHOLD, minimum=1e-12, literal_only=True,
+                          doc="eq. 1: a new viewframe when delta_t passes it (1.085e-6: a 3 deg bearing change)")
     BUDGET = InputPort("budget", int, 0, unit="B", minimum=0, literal_only=True,
                        doc="memory budget, pruned online while teaching; 0: none")
     MIN_LANDMARKS = InputPort("min_landmarks", int, DEFAULT_MIN_LANDMARKS, minimum=0, literal_only=True,
                               doc="pruning deletes viewframes left with fewer landmarks (the paper: 50)")
+    GAP_FILLING = InputPort("gap_filling", bool, True, literal_only=True,
+                            doc="landmarks found again are shifted to a common node; loops are reported")
     OBSERVATION = InputPort("observation", Observation, Ref("/perception/observation"), doc="the landmarks seen now")
-    PORTS = (PATH, THRESHOLD, BUDGET, MIN_LANDMARKS, OBSERVATION, ODOMETRY, LTMAP_OUT)
+    PORTS = (PATH, THRESHOLD, BUDGET, MIN_LANDMARKS, GAP_FILLING, OBSERVATION, ODOMETRY, LTMAP_OUT)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
         self.config = LearnConfig(threshold=self.get_input(self.THRESHOLD),
                                   budget_bytes=self.get_input(self.BUDGET) or None,
-                                  min_landmarks=self.get_input(self.MIN_LANDMARKS))
+                                  min_landmarks=self.get_input(self.MIN_LANDMARKS),
+                                  gap_filling=self.get_input(self.GAP_FILLING))
         self.learner = RouteLearner(self.config)
         self.taught: list[float] = []  # per viewframe, the tree time it was made
         self.places: list[list[float]] = []  # per viewframe, the odometry (x, y) it was made at (recording)
         self.prunes = 0
+        self.shifted = 0  # landmarks found again and merged into a common node (gap filling)
+        self.loops: list[dict[str, int | list[int]]] = []  # viewframe pairs where the route came back
+        self.closures = 0  # runs of consecutive viewframes that closed loops: one way back past earlier places
+        self._looping = False
         self.saved = False
         self._stamp: float | None = None
         self._logged = -1
@@ -73,6 +84,7 @@ class LearnRoute(BearingsDecorator):
     def initialise(self) -> None:
         self.learner = RouteLearner(self.config)
         self.taught, self.places, self.prunes, self.saved, self._stamp = [], [], 0, False, None
+        self.shifted, self.loops, self.closures, self._looping = 0, [], 0, False
 
     def update(self) -> Status:
         self._learn()
@@ -95,6 +107,12 @@ class LearnRoute(BearingsDecorator):
         self._record(self.learner.observe(observation, pose.theta), pose)  # bearings compensated by the heading
 
     def _record(self, step: LearnStep, pose: Pose2D) -> None:
+        self.shifted += step.shifted
+        if step.loop is not None:
+            self.loops.append({"viewframes": [step.loop.earlier, step.loop.later], "shared": step.loop.shared})
+            self.closures += not self._looping
+        if step.created:
+            self._looping = step.loop is not None
         if step.pruned is not None and step.pruned.fits:
             self.prunes += 1
             kept: dict[int, int] = {}  # new viewframe -> the earliest old one it came from
@@ -139,7 +157,9 @@ class LearnRoute(BearingsDecorator):
         path = self.get_input(self.PATH)
         written = os.path.abspath(path) if path else ""  # said at the end of the run: where the map went
         yield from section("ltmap", {**summary_section(tree.summary()), "map_file": written, "saved": self.saved,
-                                     "online_prunes": self.prunes, "taught": taught},
+                                     "online_prunes": self.prunes, "taught": taught,
+                                     "gap_filling": self.config.gap_filling, "shifted": self.shifted,
+                                     "loops": list(self.loops), "loop_closures": self.closures},
                            headline=("viewframes", "map_file"))
 
     def drawings(self) -> Iterator[Drawing]:

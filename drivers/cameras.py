@@ -11,8 +11,11 @@ any more (a file at its end without ``loop``, a device that cannot be re-opened)
 The frame's camera model comes from the ``calibration`` file (the YAML that ``bearings calibrate``
 writes, or any model of :func:`perception.camera.camera_from_dict`, e.g. a catadioptric mirror);
 with ``unwarp: true`` a catadioptric donut is unwarped to a 720 x 172 panorama in the grab thread
-(one ``cv2.remap`` with tables made once). Without a calibration the model is a nominal pinhole of
-``fov_deg`` across, good enough for ``bearings doctor`` and for tests, not for navigation.
+(one ``cv2.remap`` with tables made once). With a stereo calibration (``kind: stereo``, a rectified
+pair) the device delivers both images side by side in one frame, left then right (as USB stereo
+cameras do): the frame is split, and its ``right`` image is the right half. Without a calibration
+the model is a nominal pinhole of ``fov_deg`` across, good enough for ``bearings doctor`` and for
+tests, not for navigation.
 """
 
 from __future__ import annotations
@@ -37,7 +40,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from drivers.common import Stamp, build_settings, monotonic_stamp, quantity
 from maps.store import Diagnostic, InputError, YamlMap, load_yaml
-from perception.camera import CatadioptricCamera, PanoramaCamera, PinholeCamera, camera_from_dict, unwarp
+from perception.camera import CatadioptricCamera, PanoramaCamera, PinholeCamera, StereoRig, camera_from_dict, unwarp
 from perception.frame import Frame
 
 log = logging.getLogger(__name__)
@@ -189,15 +192,21 @@ class _ThreadedCamera:
     def _deliver(self, image: np.ndarray) -> None:
         model = self._model_for(image)
         height, width = image.shape[:2]
-        if (model.width, model.height) != (width, height):
-            self._fail(f"frame is {width}x{height} but the camera model is {model.width}x{model.height}")
+        pair = isinstance(model, StereoRig)  # side by side: left | right
+        if (model.width * (2 if pair else 1), model.height) != (width, height):
+            size = f"{2 * model.width}x{model.height} (a stereo pair side by side)" if pair else \
+                f"{model.width}x{model.height}"
+            self._fail(f"frame is {width}x{height} but the camera model is {size}")
             if self._newest is None:
                 self.fault = self._stats.last_error
                 self._stop.set()
             return
+        right = None
+        if pair:
+            image, right = image[:, : model.width], image[:, model.width :]
         if self._maps is not None:
             image = unwarp(image, self._maps)
-        frame = Frame(image=image, camera=self._output, stamp=self._stamp(), camera_name=self.name)
+        frame = Frame(image=image, camera=self._output, stamp=self._stamp(), camera_name=self.name, right=right)
         now = time.monotonic()
         with self._lock:
             rate = self._stats.rate

@@ -7,6 +7,7 @@ mission cannot tell them apart. Units are SI: metres, seconds, radians.
 from __future__ import annotations
 
 import contextlib
+import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
@@ -32,13 +33,51 @@ STOP = VelocityCommand(0.0, 0.0)
 
 
 @dataclass(frozen=True, slots=True)
+class PanTiltLimits:
+    """What a pan-tilt unit reports it can do: the position range of each axis (rad), the size of
+    one position step (rad; 0: continuous) and the slew speeds it takes (rad/s).
+
+    A PTU-D46 reports +-3090 positions of 185.1428 arc-seconds (+-158.91 deg), not the +-159 deg of
+    its data sheet: head behaviours clip their targets into what the unit reports (:meth:`clip`).
+    """
+
+    pan: tuple[float, float]
+    tilt: tuple[float, float]
+    pan_step: float = 0.0
+    tilt_step: float = 0.0
+    max_speed: float = math.inf
+    min_speed: float = 0.0
+
+    def clip(self, pan: float, tilt: float) -> tuple[float, float]:
+        """``(pan, tilt)`` clipped into the ranges and rounded to the nearest position step (inside)."""
+        return _snap(pan, self.pan, self.pan_step), _snap(tilt, self.tilt, self.tilt_step)
+
+    def clip_speed(self, speed: float) -> float:
+        """A slew speed the unit takes."""
+        return min(max(speed, self.min_speed), self.max_speed)
+
+
+def _snap(angle: float, bounds: tuple[float, float], step: float) -> float:
+    low, high = bounds
+    value = min(max(angle, low), high)
+    if step > 0.0:
+        value = round(value / step) * step
+        value = min(max(value, math.ceil(low / step - 1e-9) * step), math.floor(high / step + 1e-9) * step)
+    return value
+
+
+@dataclass(frozen=True, slots=True)
 class PanTiltState:
-    """Where the pan-tilt unit points (rad) and whether it is still moving."""
+    """Where the pan-tilt unit points (rad), whether it is still moving, what it can do (``limits``;
+    None when the driver does not say) and how many times it has re-homed since it was opened
+    (``homings``: a unit that resets after a power dip finds its limits and stands at home)."""
 
     pan: float = 0.0
     tilt: float = 0.0
     moving: bool = False
     stamp: float = 0.0
+    limits: PanTiltLimits | None = None
+    homings: int = 0
 
 
 @dataclass(frozen=True, slots=True)

@@ -10,6 +10,9 @@ every ``poll_period``. ``move()``, ``halt()`` and ``state()`` return at once.
 
 - Targets outside the unit's limits (or the profile's tighter ``*_min_deg``/``*_max_deg``) raise
   ``ValueError`` in ``move()`` before anything is sent; speeds are clamped to the unit's bounds.
+  ``state()`` carries those limits, the position step and the speed bounds
+  (:class:`~drivers.interfaces.PanTiltLimits`) and the ``homings`` count, so head behaviours keep
+  inside what this unit reports and notice a reset.
 - A ``!`` reply to a command is kept in ``last_error`` (``errors`` counts them) and raised once
   as :class:`PtuError` from the next ``move()`` or ``state()``.
 - What the unit sends is read as a stream of ``*``/``!`` messages, not lines
@@ -26,6 +29,7 @@ every ``poll_period``. ``move()``, ``halt()`` and ``state()`` return at once.
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import math
 import threading
@@ -39,7 +43,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from drivers import ptu_d46_codec as codec
 from drivers.common import DriverFault, Stamp, build_settings, monotonic_stamp, quantity
-from drivers.interfaces import PanTiltState
+from drivers.interfaces import PanTiltLimits, PanTiltState
 
 log = logging.getLogger(__name__)
 
@@ -335,7 +339,25 @@ class PtuD46:
             return
         pan, tilt = self._positions
         self._state = PanTiltState(codec.to_radians(pan, limits.pan.resolution),
-                                   codec.to_radians(tilt, limits.tilt.resolution), moving, self._stamp())
+                                   codec.to_radians(tilt, limits.tilt.resolution), moving, self._stamp(),
+                                   self._reported, self.homings)
+
+    @functools.cached_property
+    def _reported(self) -> PanTiltLimits:
+        """The limits a behaviour must keep to: the unit's, within the profile's soft limits (rad)."""
+        limits, s = self._limits(), self.settings
+
+        def bounds(axis: AxisLimits, low: float | None, high: float | None) -> tuple[float, float]:
+            return (max(axis.min_rad, -math.inf if low is None else math.radians(low)),
+                    min(axis.max_rad, math.inf if high is None else math.radians(high)))
+
+        pan, tilt = limits.pan, limits.tilt
+        return PanTiltLimits(bounds(pan, s.pan_min_deg, s.pan_max_deg), bounds(tilt, s.tilt_min_deg, s.tilt_max_deg),
+                             codec.to_radians(1, pan.resolution), codec.to_radians(1, tilt.resolution),
+                             min(codec.to_radians(pan.max_speed, pan.resolution),
+                                 codec.to_radians(tilt.max_speed, tilt.resolution)),
+                             max(codec.to_radians(pan.min_speed, pan.resolution),
+                                 codec.to_radians(tilt.min_speed, tilt.resolution)))
 
     # -- one command, one reply ----------------------------------------------------------------------
     def _command(self, name: str, value: int | None = None) -> bool:

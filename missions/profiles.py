@@ -33,11 +33,13 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
+from behaviours.ports import Ref
 from drivers.interfaces import Robot
 from drivers.pioneer_body import BODIES
 from drivers.safety.settings import SafetySettings, monitor_config
 from maps.located import FILE_MODEL_CONFIG, diagnose, suggest, validate
 from maps.store import Diagnostic, InputError, YamlMap, load_yaml
+from missions.language import MissionSpec
 from perception.collision_monitor import MonitorConfig
 
 PROFILES = Path(__file__).resolve().parent.parent / "drivers" / "profiles"
@@ -147,6 +149,29 @@ def _opener(target: str) -> tuple[Callable[..., Any] | None, type[BaseModel] | N
         declared,)
     models = [c for c in candidates if isinstance(c, type) and issubclass(c, BaseModel)]
     return opener, models[0] if models else None
+
+
+PTU_KEYS = ("/ptu/state", "/ptu/command")  # a mission that reads or writes these drives a pan-tilt unit
+
+
+def mission_problems(mission: MissionSpec, path: str | Path) -> list[Diagnostic]:
+    """What ``mission`` needs that the robot of profile ``path`` lacks, without opening anything: a
+    camera it grabs (its ``cameras:``), the pan-tilt unit it reads or commands. The profile itself
+    must be valid (:class:`InputError` otherwise)."""
+    name, devices = load_profile(path)
+    cameras = [d.name for d in devices if d.role == "camera"]
+    problems = []
+    missing = [c for c in mission.cameras or () if c not in cameras]
+    if missing:
+        problems.append(Diagnostic(mission.file, 0, 0, f"the mission uses camera(s) {', '.join(missing)}, which "
+                                   f"robot {name!r} ({path}) does not have (it has: {', '.join(cameras) or 'none'})"))
+    nodes = [node for root in (*mission.sense, mission.tree) for node in root.walk()]
+    uses_ptu = any(isinstance(v, Ref) and v.base in PTU_KEYS for n in nodes for v in n.inputs.values()) or any(
+        key in PTU_KEYS for n in nodes for key in n.outputs.values())
+    if uses_ptu and not any(d.role == "ptu" for d in devices):
+        problems.append(Diagnostic(mission.file, 0, 0, f"the mission reads or drives the pan-tilt unit, which robot "
+                                   f"{name!r} ({path}) does not have"))
+    return problems
 
 
 def open_robot(path: str | Path, *, clock: Callable[[], float] | None = None) -> Robot:

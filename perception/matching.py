@@ -103,6 +103,27 @@ def match_descriptors(
     return Matches(qa, ta, da)
 
 
+def match_within(descriptors: np.ndarray, query: np.ndarray, kind: str, *, ratio: float | None = None) -> Matches:
+    """Each ``query`` row of ``descriptors`` matched to the nearest OTHER row of the same array, with
+    the ratio test against the second-nearest other row (no mutual check): a set searched for
+    copies of its own rows (the LT-map's landmarks stored twice)."""
+    ratio = DEFAULT_RATIO.get(kind, 0.75) if ratio is None else ratio
+    if not 0.0 < ratio <= 1.0:
+        raise ValueError(f"ratio must be in (0, 1], got {ratio}")
+    query = np.asarray(query, dtype=np.int64).reshape(-1)
+    if len(query) == 0 or len(descriptors) < 2:
+        return _empty()
+    norm, dtype = (cv2.NORM_HAMMING, cv2.CV_32S) if kind in BINARY_KINDS else (cv2.NORM_L2, cv2.CV_32F)
+    k = min(3, len(descriptors))
+    dist, index = cv2.batchDistance(np.ascontiguousarray(descriptors[query]), descriptors, dtype, normType=norm, K=k)
+    order = np.argsort(index == query[:, None], axis=1, kind="stable")  # the row itself last
+    dist = np.take_along_axis(dist, order, axis=1).astype(np.float64)
+    index = np.take_along_axis(index, order, axis=1)
+    second = dist[:, 1] if k == 3 else np.full(len(query), np.inf)
+    keep = (dist[:, 0] < ratio * second) & (index[:, 0] != query)
+    return Matches(query[keep], index[keep, 0].astype(np.int64), dist[keep, 0])
+
+
 def match_features(query: Features, train: Features, *, ratio: float | None = None, mutual: bool = True) -> Matches:
     """Match two feature sets of the same kind."""
     if query.kind != train.kind:

@@ -31,25 +31,30 @@ from perception.matching import DEFAULT_RATIO
 
 @dataclass(frozen=True, slots=True)
 class StereoPoints:
-    """Matched points of a stereo pair: left pixels, disparities (px), depths (m), body points."""
+    """Matched points of a stereo pair: left pixels, disparities (px), depths (m), body points, and
+    (from :func:`sparse_stereo`) the left features' descriptors of ``kind``, so the points can be
+    recognised again (visual localisation)."""
 
     uv_left: np.ndarray
     disparity: np.ndarray
     depth: np.ndarray
     points: np.ndarray
+    descriptors: np.ndarray | None = None
+    kind: str = ""
 
     def __len__(self) -> int:
         return len(self.depth)
 
 
-def points_from_disparity(rig: StereoRig, uv_left: np.ndarray, disparity: np.ndarray) -> StereoPoints:
+def points_from_disparity(rig: StereoRig, uv_left: np.ndarray, disparity: np.ndarray,
+                          descriptors: np.ndarray | None = None, kind: str = "") -> StereoPoints:
     """Triangulate left pixels with their disparities (``Z = fx * B / d``) into body-frame points."""
     uv = np.asarray(uv_left, dtype=np.float64).reshape(-1, 2)
     d = np.asarray(disparity, dtype=np.float64).ravel()
     depth = rig.depth_from_disparity(d)
     bearings = rig.left.pixel_to_bearing(uv)
     points = bearings * (depth / bearings[:, 0])[:, None]  # body x is the optical axis: x = Z
-    return StereoPoints(uv, d, depth, points)
+    return StereoPoints(uv, d, depth, points, descriptors, kind)
 
 
 def sparse_stereo(
@@ -63,13 +68,17 @@ def sparse_stereo(
     min_disparity: float = 0.5,
     max_disparity: float | None = None,
     ratio: float | None = None,
+    levels: int | None = None,
 ) -> StereoPoints:
-    """Feature matches along horizontal epipolar lines (see the module docstring)."""
+    """Feature matches along horizontal epipolar lines (see the module docstring). ``levels``: ORB's
+    pyramid (default 1: the same scale in both views, full-resolution positions; more levels give
+    descriptors that recognise the point again from nearer or farther)."""
     max_disparity = rig.width / 2 if max_disparity is None else max_disparity
-    levels = 1 if kind == "orb" else None  # same scale in both views: full-resolution positions
+    if kind == "orb" and levels is None:
+        levels = 1
     fl = detect(left, kind, n_features=n_features, upright=True, levels=levels)
     fr = detect(right, kind, n_features=n_features, upright=True, levels=levels)
-    empty = points_from_disparity(rig, np.zeros((0, 2)), np.zeros(0))
+    empty = points_from_disparity(rig, np.zeros((0, 2)), np.zeros(0), fl.descriptors[:0], kind)
     if len(fl) == 0 or len(fr) == 0:
         return empty
     disparity = fl.keypoints_uv[:, None, 0] - fr.keypoints_uv[None, :, 0]
@@ -102,7 +111,7 @@ def sparse_stereo(
     uv_right = _subpixel(right, fr.keypoints_uv[ri])
     d = uv_left[:, 0] - uv_right[:, 0]
     ok = (d >= min_disparity) & (np.abs(uv_left[:, 1] - uv_right[:, 1]) <= max_dy)
-    return points_from_disparity(rig, uv_left[ok], d[ok])
+    return points_from_disparity(rig, uv_left[ok], d[ok], fl.descriptors[li][ok], kind)
 
 
 def _subpixel(image: np.ndarray, uv: np.ndarray) -> np.ndarray:

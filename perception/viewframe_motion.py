@@ -18,19 +18,44 @@ matched a viewframe, and this module answers them:
   When none does (a pruned viewframe with few landmarks left), a visual compass
   (:func:`compass_motion`: the rotation of all matched landmarks) keeps the robot going rather
   than stopping it.
+- **How far from it?** :func:`change_since`: eq. 1 (:func:`perception.similarity.delta_t`) of
+  the landmarks Z-infinity keeps as inliers (far ones and near ones consistent with the
+  translation), its rotation removed. Eq. 1 as written weighs a mismatched landmark up to
+  about 4 b, over 2000 times a 3 degree change, so one mismatch in a few hundred would decide
+  alone; the inliers leave mismatches out. Teaching (when to make a viewframe) and following
+  (when one is reached) measure it the same way.
+- **Which rule made it?** Every estimate says so (:class:`RuledMotion`, :data:`RULES`): the
+  rung of the ladder whose far set gave the rotation (``zinf_1deg`` .. ``zinf_8deg``) or the
+  ``compass``, so route following can count how often it went beyond the paper's 1 degree.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from perception.similarity import DEFAULT_SCALE, delta_t
 from perception.zinf import ZinfResult, ZinfStatus, estimate_motion, estimate_translation
 
 ZINF_MIN_LANDMARKS = 8  # perception.zinf.estimate_motion's default minimum
 FAR_THRESHOLDS = tuple(np.radians((1.0, 2.0, 4.0, 8.0)))  # rad: "unmoved after rotation", tightest first
+COMPASS = "compass"
+RULES = (*(f"zinf_{round(math.degrees(t))}deg" for t in FAR_THRESHOLDS), COMPASS)  # zinf_1deg, ..., compass
+
+
+@dataclass(frozen=True, slots=True)
+class RuledMotion:
+    """An estimate and the rule that made it (one of :data:`RULES`)."""
+
+    motion: ZinfResult
+    rule: str
+
+    @property
+    def compass(self) -> bool:
+        return self.rule == COMPASS
 
 
 def lost_threshold(viewframe_size: int, min_matches: int) -> int:
@@ -39,17 +64,23 @@ def lost_threshold(viewframe_size: int, min_matches: int) -> int:
     return max(ZINF_MIN_LANDMARKS, math.ceil(viewframe_size / 2) if small else min_matches)
 
 
-def zinf_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> tuple[ZinfResult, bool]:
+def zinf_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> RuledMotion:
     """Z-infinity (eqs. 2-6) with the tightest far threshold that separates a rotation, else the
-    compass (see the module doc). Returns the estimate and whether it is the compass."""
-    motion = estimate_motion(ref, cur, rng=rng, far_threshold=FAR_THRESHOLDS[0])
-    for threshold in FAR_THRESHOLDS[1:]:
-        if motion.status is not ZinfStatus.NO_ROTATION:
-            return motion, False
+    compass (see the module doc); with the rule that made the estimate."""
+    for rule, threshold in zip(RULES, FAR_THRESHOLDS, strict=False):
         motion = estimate_motion(ref, cur, rng=rng, far_threshold=threshold)
-    if motion.status is ZinfStatus.NO_ROTATION:
-        return compass_motion(ref, cur, rng), True
-    return motion, False
+        if motion.status is not ZinfStatus.NO_ROTATION:
+            return RuledMotion(motion, rule)
+    return RuledMotion(compass_motion(ref, cur, rng), COMPASS)
+
+
+def change_since(ref: np.ndarray, cur: np.ndarray, motion: ZinfResult, scale: float = DEFAULT_SCALE) -> float:
+    """Eq. 1 from a viewframe's bearings ``ref`` to ``cur`` over ``motion``'s inliers (all when it has
+    none), its rotation removed; ``inf`` when it found no rotation (see the module doc)."""
+    if not motion.rotation_ok:
+        return float("inf")
+    weights = motion.inliers.astype(np.float64) if motion.inliers.any() else None
+    return delta_t(ref, cur, rotation=motion.rotation, weights=weights, scale=scale)  # eq. 1
 
 
 def compass_motion(ref: np.ndarray, cur: np.ndarray, rng: np.random.Generator) -> ZinfResult:

@@ -9,10 +9,11 @@ module           node types
 ``map_stereo``   ``MapStereo`` (dense stereo into the exploration map)
 ``select_goal``  ``SelectGoalPoint`` (the next goal: eq. 1, frontier mode, done)
 ``follow_path``  ``FollowPath`` (the goal's path, with the collision checks)
-``gaze``         ``WatchInterestEdges``, ``LookAround`` (where the cameras look: eq. 2-5)
+``gaze``         ``WatchInterestEdges`` (where the cameras look while driving: eq. 2-5)
+``look_around``  ``LookAround`` (all around while the robot stands)
 ===============  ====================================================================
 
 ``ports`` holds the ports these nodes share (the map, the goal, the pose, the robot's disc, the
-head on the base), ``drawing`` the map's drawings for the recording. docs/exploration.md is the
-overview.
+head on the base), ``head`` the head's ports and what the unit reports, ``drawing`` the map's
+drawings for the recording. docs/exploration.md is the overview.
 """

@@ -34,6 +34,8 @@ from maps.exploration.grid import ExplorationMap
 from maps.exploration.travel import TravelCost
 from perception.geometry import Pose2D
 
+STRATEGIES = ("nearby_attraction", "attraction", "closest_frontier")
+
 
 @register
 class SelectGoalPoint(BearingsBehaviour):
@@ -42,11 +44,14 @@ class SelectGoalPoint(BearingsBehaviour):
     ``A_P = d(P_p, P_b) - eta G(v_S, P_b)``: the detected point farthest beyond the explored
     border, less eta times the travel cost to that border; the goal is the border point ``P_b``
     (see :mod:`maps.exploration.goal`). No point more than ``k`` beyond the border: frontier mode,
-    the closest reachable border point, until one is (``strategy: closest_frontier``: frontier
-    mode always, the evaluation's baseline). The goal is chosen again every ``reselect`` seconds
-    (the map grows as the robot drives; the current goal is kept while within ``hysteresis`` of the
-    best) and when the robot is within ``reach`` of it (its point is then spent and its border point
-    avoided: the unknown beyond it was not seen from there). Points seen in fewer than
+    the closest reachable border point, until one is. ``strategy``: ``nearby_attraction`` (the
+    default) lets only points whose border point costs at most ``nearby`` metres more than the
+    closest one compete; ``attraction`` is eq. 1 over all points, as the paper writes it (it goes
+    after far points first); ``closest_frontier`` is frontier mode always (the evaluation's
+    baseline). The goal is chosen again every ``reselect`` seconds (the map grows as the robot
+    drives; the current goal is kept while within ``hysteresis`` of the best) and when the robot
+    is within ``reach`` of it (its point is then spent and its border point avoided: the unknown
+    beyond it was not seen from there). Points seen in fewer than
     ``min_sightings`` observations do not attract (stray stereo matches).
 
     RUNNING while there is a goal (written to ``goal``; path following and the gaze read it);
@@ -62,8 +67,9 @@ class SelectGoalPoint(BearingsBehaviour):
     The mode, strikes, spent points, avoided targets and verified places outlive re-entries.
     """
 
-    STRATEGY = InputPort("strategy", str, "attraction", choices=("attraction", "closest_frontier"), literal_only=True,
-                         doc="attraction: eq. 1 with frontier mode; closest_frontier: the closest border always")
+    STRATEGY = InputPort("strategy", str, "nearby_attraction", choices=STRATEGIES, literal_only=True,
+                         doc="nearby_attraction: eq. 1 among the points whose border is within nearby of the "
+                             "closest; attraction: eq. 1 over all points; closest_frontier: the closest border always")
     ETA = InputPort("eta", float, 0.25, minimum=0.0, maximum=0.5, literal_only=True,
                     doc="weight of the travel cost in eq. 1")
     K = InputPort("k", float, 1.0, unit="m", minimum=0.0, maximum=100.0, literal_only=True,
@@ -92,20 +98,25 @@ class SelectGoalPoint(BearingsBehaviour):
                                   "(0: never)")
     LOOK_BACK = InputPort("look_back", float, 1.0, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
                           doc="...from this far before the first place the robot's disc cannot pass")
+    NEARBY = InputPort("nearby", float, 1.0, unit="m", minimum=0.0, maximum=100.0, literal_only=True,
+                       doc="nearby_attraction: a point attracts when its border costs at most this more than the "
+                           "closest border")
     GOAL_OUT: OutputPort[Goal | None] = OutputPort("goal", Goal, "/map/exploration_goal",
                                                    doc="the goal: border point, path, mode (None: none)")
     PORTS = (STRATEGY, ETA, K, ROBOT_RADIUS, CLEARANCE, MARGIN, PENALTY, PATIENCE, MIN_FRONTIER, HYSTERESIS,
-             RESELECT, REACH, MIN_SIGHTINGS, POINT_CLEARANCE, VERIFY_RADIUS, LOOK_BACK, MAP, POSE, GOAL_OUT)
+             RESELECT, REACH, MIN_SIGHTINGS, POINT_CLEARANCE, VERIFY_RADIUS, LOOK_BACK, MAP, POSE, GOAL_OUT, NEARBY)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
+        strategy = self.get_input(self.STRATEGY)
         self.params = GoalParams(
             eta=self.get_input(self.ETA), k=self.get_input(self.K),
             robot_radius=self.get_input(ROBOT_RADIUS) + self.get_input(CLEARANCE),
             min_frontier=self.get_input(self.MIN_FRONTIER),
             margin=self.get_input(self.MARGIN), penalty=self.get_input(self.PENALTY),
             patience=self.get_input(self.PATIENCE), hysteresis=self.get_input(self.HYSTERESIS),
-            closest_frontier=self.get_input(self.STRATEGY) == "closest_frontier",
+            closest_frontier=strategy == "closest_frontier",
+            nearby=self.get_input(self.NEARBY) if strategy == "nearby_attraction" else math.inf,
             min_sightings=self.get_input(self.MIN_SIGHTINGS),
             point_clearance=self.get_input(self.POINT_CLEARANCE),
             verify_radius=self.get_input(self.VERIFY_RADIUS), look_back=self.get_input(self.LOOK_BACK),

@@ -85,23 +85,21 @@ class McapLog:
         """Every record in file order, counting messages per topic (a file without an index)."""
         contents = LogContents(str(self.path), "mcap")
         counts: dict[int, int] = {}
-        channels: dict[int, Any] = {}
-        schemas: dict[int, Any] = {}
+        declared = _Declared()
         first, last = None, None
         for record in self._records():
-            if isinstance(record, Schema):
-                schemas[record.id] = record
-            elif isinstance(record, Channel):
-                channels[record.id] = record
-            elif isinstance(record, Message):
+            if declared.note(record):
+                continue
+            if isinstance(record, Message):
                 counts[record.channel_id] = counts.get(record.channel_id, 0) + 1
                 first = record.log_time if first is None else min(first, record.log_time)
                 last = record.log_time if last is None else max(last, record.log_time)
             elif isinstance(record, Metadata) and record.name == "bearings":
                 contents.metadata = dict(record.metadata)
         contents.start_ns, contents.end_ns = first or 0, last or 0
-        for channel_id, channel in sorted(channels.items()):
-            contents.topics[channel.topic] = _topic(channel, schemas.get(channel.schema_id), counts.get(channel_id, 0))
+        for channel_id, channel in sorted(declared.channels.items()):
+            contents.topics[channel.topic] = _topic(channel, declared.schemas.get(channel.schema_id),
+                                                    counts.get(channel_id, 0))
         contents.cut = self.cut
         return contents
 
@@ -141,20 +139,17 @@ class McapLog:
             raise LogError(f"{self.path}: at byte {self._file.tell()}: damaged: {first_line(exc)}") from None
 
     def _unindexed_messages(self, wanted: set[str]) -> Iterator[tuple[Any, Any, Any]]:
-        channels: dict[int, Any] = {}
-        schemas: dict[int, Any] = {}
+        declared = _Declared()
         for record in self._records():
-            if isinstance(record, Schema):
-                schemas[record.id] = record
-            elif isinstance(record, Channel):
-                channels[record.id] = record
-            elif isinstance(record, Message):
-                channel = channels.get(record.channel_id)
+            if declared.note(record):
+                continue
+            if isinstance(record, Message):
+                channel = declared.channels.get(record.channel_id)
                 if channel is None:
                     raise LogError(f"{self.path}: at byte {self._file.tell()}: a message on channel "
                                    f"{record.channel_id}, which no record declared")
                 if channel.topic in wanted:
-                    yield schemas.get(channel.schema_id), channel, record
+                    yield declared.schemas.get(channel.schema_id), channel, record
 
     def _records(self) -> Iterator[Any]:
         """The file's records in order; at a cut, stop and say where (``cut``); damage is a LogError."""
@@ -170,6 +165,24 @@ class McapLog:
                 self.cut = f"cut at byte {where} of {self.size} (the run did not close the file)"
                 return
             raise LogError(f"{self.path}: at byte {where}: damaged: {first_line(exc)}") from None
+
+
+class _Declared:
+    """The schemas and channels a file has declared so far, read record by record in file order."""
+
+    def __init__(self) -> None:
+        self.schemas: dict[int, Any] = {}
+        self.channels: dict[int, Any] = {}
+
+    def note(self, record: Any) -> bool:
+        """Keep a schema or channel record (True); any other record is the caller's (False)."""
+        if isinstance(record, Schema):
+            self.schemas[record.id] = record
+        elif isinstance(record, Channel):
+            self.channels[record.id] = record
+        else:
+            return False
+        return True
 
 
 def _topic(channel: Any, schema: Any, count: int) -> TopicInfo:

@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from drivers.interfaces import PanTiltState
+from drivers.interfaces import PanTiltLimits, PanTiltState
 from drivers.sim.world_values import PtuSpec
 
 
@@ -43,7 +43,13 @@ class SimPanTilt:
         self._target = (self.pan, self.tilt)
 
     def state(self) -> PanTiltState:
-        return PanTiltState(self.pan, self.tilt, self.moving, self._clock())
+        return PanTiltState(self.pan, self.tilt, self.moving, self._clock(), self.limits)
+
+    @property
+    def limits(self) -> PanTiltLimits:
+        """What the simulated unit reports: the world's limits and top speed, continuous positions."""
+        s = self.spec
+        return PanTiltLimits(s.pan_limits, s.tilt_limits, max_speed=s.max_speed)
 
     @property
     def moving(self) -> bool:

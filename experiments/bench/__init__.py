@@ -9,6 +9,7 @@ AREAS = {
     "sim": "experiments.bench.sim",
     "perception": "experiments.bench.perception",
     "ltmap": "experiments.bench.ltmap",
+    "localisation": "experiments.bench.localisation",
     "sweep": "experiments.bench.sweep",
     "run": "experiments.bench.run",
 }

@@ -35,9 +35,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Run an area's evaluation episodes through the sweep runner and print one JSON object of "
                     "named figures (--json) or a table. Works on any world file the simulator reads.",
         epilog="Areas and their --option names (an unknown name is refused with the list): exploration "
-               "(people; docs/exploration.md), ltmap (camera, route, min_landmarks, goal_tolerance, rotation, "
-               "people; docs/ltmap.md), roadmap (targets, starts, people; docs/roadmap.md). people=N: N people "
-               "drawn from the seed in the way of the robot.",
+               "(localisation, people, variants; docs/exploration.md), ltmap (camera, route, min_landmarks, "
+               "goal_tolerance, rotation, gap_filling, people; docs/ltmap.md), roadmap (targets, starts, people; "
+               "docs/roadmap.md). people=N: N people drawn from the seed in the way of the robot.",
     )
     parser.add_argument("area", choices=sorted(AREAS), help="what to evaluate")
     parser.add_argument("--world", required=True, metavar="NAME|PATH", help="a shipped world or a world file")

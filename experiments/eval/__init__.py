@@ -45,3 +45,17 @@ class EvalOptions:
     # what the area's check_world and check_options (or None) returned for these inputs, when the
     # caller has checked them already (the command does, before any episode); None: run() checks
     checked: tuple[Any, Any] | None = None
+
+
+def count_option(name: str, text: str | None, *, default: int, maximum: int) -> int:
+    """An area option that counts something (``people``, ``starts``): 0 to ``maximum``; ``default``
+    when not given; a ``ValueError`` naming the option otherwise."""
+    if text is None:
+        return default
+    try:
+        count = int(text)
+    except ValueError:
+        raise ValueError(f"{name}: an integer expected, got {text!r}") from None
+    if not 0 <= count <= maximum:
+        raise ValueError(f"{name} must be 0 to {maximum}, got {count}")
+    return count

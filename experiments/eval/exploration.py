@@ -1,12 +1,22 @@
-"""``bearings eval exploration``: explored floor against path length and time, three ways.
+"""``bearings eval exploration``: explored floor against path length and time, four ways.
 
-Three variants of the shipped ``explore`` mission, each over the same seeds:
+Four variants of the shipped ``explore`` mission, each over the same seeds (and with each
+localisation the ``localisation`` option names, see below):
 
-- ``method``: attractive power (eq. 1) with frontier mode, the cameras watching interest edges;
+- ``method``: the mission's default, attractive power (eq. 1) among the borders about as close as
+  the closest (``nearby_attraction``), frontier mode otherwise, the cameras watching interest edges;
 - ``baseline``: the closest reachable border always (classic frontier exploration), cameras fixed
   straight ahead;
 - ``fixed``: the method's goal selection with the cameras fixed straight ahead (so method vs fixed
-  measures the gaze, fixed vs baseline the goal selection).
+  measures the gaze, fixed vs baseline the goal selection);
+- ``eq1``: eq. 1 over all points, as the paper writes it, the cameras watching interest edges.
+
+Two more run when named (``--option variants=method,gaze_before,...``: the variants to run, the
+method always among them): ``gaze_before``, the method with the gaze's earlier rules (a watched
+point dropped once its bearing passes 90 degrees, ``leave: pan_limit``; the head turned back to
+straight ahead, ``turn_back: front``), so method vs gaze_before measures eq. 3 and eq. 4; and
+``closest_edges``, the closest reachable border with the cameras watching interest edges (the
+goal selection alone against the method's).
 
 The measure (ground truth, evaluation only). The reference is the world's reachable floor
 (:func:`drivers.sim.floor.reachable_floor`: where the robot's centre can go from the start). What
@@ -25,8 +35,20 @@ Figures per variant (means over seeds unless named otherwise): final ``coverage`
 ``collisions`` and ``safety_stops`` (summed over the runs), ``min_clearance_m`` (the smallest, when
 the simulator reports it), ``path_length_m`` and ``sim_time_s``, coverage after 5, 10, 20 and 40 m of path
 and after 60, 120 and 240 s, and the path length and time to reach 50, 80, 90 and 95 % (None when
-not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m to
-the two others'.
+not reached by some episode). Comparisons: ratios of the method's coverage after 10 and 20 m and
+120 s, of its path and time to 90 and 95 % and of its path length to the three others' (below 1
+for a path or a time: the method's is shorter).
+
+Localisation (option ``localisation``): ``visual`` (the default) runs the mission as shipped, its pose
+from the stereo pair's own features; ``ideal`` gives it the simulator's identified landmarks (the
+oracle no robot has); ``visual,ideal`` runs both, the ideal columns named ``VARIANT/ideal``, so the
+table shows what the oracle was worth (and ``VARIANT_visual_vs_ideal`` ratios of the map's area on
+obstacles and of the path). The pose figures compare the localisation's pose (the report's
+``exploration.localisation``: its final pose and a track of one row a second) with the truth at
+the same time, the odometry frame placed at the true start: ``pose_error_m`` and
+``heading_error_deg`` at the end, their maxima over the run, the position error after 60, 120 and
+240 s, the final ``pose_sigma_m`` the localisation gave itself, and ``pose_ok`` (episodes that end
+within 0.10 m and 2 degrees).
 
 People (``--option people=N``, :mod:`experiments.eval.people`): N people drawn from the seed,
 standing in the rooms or walking back and forth between two points of the floor the robot
@@ -40,6 +62,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -59,21 +82,43 @@ from maps.exploration.codec import unpack_cells
 from maps.exploration.grid import GridFrame
 from maps.exploration.head import StereoHead
 from maps.exploration.integrate import scan_cells
-from perception.geometry import Pose2D
+from perception.geometry import Pose2D, wrap_angle
 
-DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed"
+DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed, eq. 1"
 MISSION = "explore"
 VARIANTS: dict[str, dict[str, str]] = {
-    "method": {"strategy": "attraction", "gaze": "edges"},
+    "method": {"strategy": "nearby_attraction", "gaze": "edges"},
     "baseline": {"strategy": "closest_frontier", "gaze": "fixed"},
-    "fixed": {"strategy": "attraction", "gaze": "fixed"},
+    "fixed": {"strategy": "nearby_attraction", "gaze": "fixed"},
+    "eq1": {"strategy": "attraction", "gaze": "edges"},
+    "gaze_before": {"strategy": "nearby_attraction", "gaze": "edges", "leave": "pan_limit", "turn_back": "front"},
+    "closest_edges": {"strategy": "closest_frontier", "gaze": "edges"},
 }
+DEFAULT_VARIANTS = ("method", "baseline", "fixed", "eq1")
 DISTANCES = (5.0, 10.0, 20.0, 40.0)  # m of path: coverage reached by then
 TIMES = (60.0, 120.0, 240.0)  # s
 LEVELS = (0.5, 0.8, 0.9, 0.95)  # coverage: path length and time to reach it
 RESOLUTION = 0.05  # m: the reference floor grid
 GOAL = 0.95  # the issue's criterion
-OPTIONS = {crowd.OPTION: crowd.HELP + " (in the rooms)"}
+OPTIONS = {
+    "localisation": "how the robot localises: visual (the stereo pair's own features; default), ideal (the "
+                    "simulator's identified landmarks, an oracle), or visual,ideal (both, side by side)",
+    crowd.OPTION: crowd.HELP + " (in the rooms)",
+    "variants": f"the variants to run, comma-separated ({', '.join(VARIANTS)}; default "
+                f"{','.join(DEFAULT_VARIANTS)}; the method always runs)",
+}
+LOCALISATIONS = {"visual": "stereo", "ideal": "landmarks"}  # -> the mission's localisation input (a camera)
+POSE_GOAL = (0.10, 2.0)  # m, deg: the localisation's error at the end of a run
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The area's options, checked: people per seed, the variants to run (the method first) and the
+    localisations to run each with."""
+
+    people: int = 0  # people in the rooms
+    variants: tuple[str, ...] = DEFAULT_VARIANTS
+    localisations: tuple[str, ...] = ("visual",)  # LOCALISATIONS' names, each a set of columns
 
 
 def check_world(world: str) -> FloorGrid:
@@ -85,15 +130,40 @@ def check_world(world: str) -> FloorGrid:
     return floor
 
 
-def check_options(world: str, extra: Mapping[str, str]) -> int:
-    """The options (``OPTIONS``) checked: the number of people; ``ValueError`` with the problem."""
-    return crowd.parse_people(extra.get(crowd.OPTION))
+def check_options(world: str, extra: Mapping[str, str]) -> Settings:
+    """The options (``OPTIONS``) checked: the variants, the localisations (against the world's cameras)
+    and the number of people; ``ValueError`` with the problem."""
+    text = extra.get("variants")
+    named = [n.strip() for n in text.split(",") if n.strip()] if text is not None else list(DEFAULT_VARIANTS)
+    unknown = [n for n in named if n not in VARIANTS]
+    if unknown or not named:
+        raise ValueError(f"variants={text!r}: {', '.join(unknown) or 'none named'} "
+                         f"(known: {', '.join(VARIANTS)})")
+    variants = ("method", *dict.fromkeys(n for n in named if n != "method"))
+    names = tuple(dict.fromkeys(n.strip() for n in extra.get("localisation", "visual").split(",")))
+    unknown = [n for n in names if n not in LOCALISATIONS]
+    if unknown or not names:
+        raise ValueError(f"localisation must be visual, ideal or visual,ideal, got {extra.get('localisation')!r}")
+    cameras = {spec.name for spec in load_world(world).cameras}
+    for name in names:
+        if LOCALISATIONS[name] not in cameras:
+            raise ValueError(f"localisation {name} needs the camera {LOCALISATIONS[name]!r}, which world {world!r} "
+                             f"does not have (cameras: {', '.join(sorted(cameras))})")
+    return Settings(crowd.parse_people(extra.get(crowd.OPTION)), variants=variants, localisations=names)
 
 
-def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: float | None = None) -> list[Episode]:
-    """The evaluation's runs: every variant on every seed (in ``world``, or per seed ``world[seed]``)."""
+def column(variant: str, localisation: str) -> str:
+    """A table column: the variant, with ``/ideal`` for the ideal localisation."""
+    return variant if localisation == "visual" else f"{variant}/{localisation}"
+
+
+def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: float | None = None,
+             variants: Sequence[str] = DEFAULT_VARIANTS, localisations: Sequence[str] = ("visual",)) -> list[Episode]:
+    """The evaluation's runs: every variant named on every seed (in ``world``, or per seed ``world[seed]``),
+    with every localisation."""
     where = world if isinstance(world, Mapping) else dict.fromkeys(seeds, world)
-    return [Episode(MISSION, where[seed], seed, inputs, max_time_s) for inputs in VARIANTS.values() for seed in seeds]
+    return [Episode(MISSION, where[seed], seed, {**VARIANTS[name], "localisation": LOCALISATIONS[loc]}, max_time_s)
+            for loc in localisations for name in variants for seed in seeds]
 
 
 def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
@@ -111,9 +181,14 @@ def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
 
 
 def variant_of(inputs: dict[str, Any]) -> str:
+    """The column (:func:`column`) of the variant whose inputs are exactly ``inputs`` besides the
+    localisation."""
+    given = {k: str(v) for k, v in inputs.items() if v is not None and k != "localisation"}
+    camera = str(inputs.get("localisation", LOCALISATIONS["visual"]))
+    localisation = next((k for k, v in LOCALISATIONS.items() if v == camera), None)
     for name, values in VARIANTS.items():
-        if all(str(inputs.get(k)) == v for k, v in values.items()):
-            return name
+        if localisation is not None and given == values:
+            return column(name, localisation)
     raise KeyError(f"no variant has the inputs {inputs}")
 
 
@@ -168,6 +243,37 @@ def map_in_world(report: dict[str, Any]) -> np.ndarray:
     return start_to_world(Pose2D(x0, y0, th0), local)
 
 
+def pose_errors(report: dict[str, Any]) -> dict[str, Any]:
+    """The localisation's pose against the truth (module docstring); empty without a pose track."""
+    located = report.get("exploration", {}).get("localisation", {})
+    track = np.asarray(located.get("track", []), dtype=np.float64).reshape(-1, 6)
+    final = located.get("final_pose")
+    if not len(track) or not final:
+        return {}
+    trajectory = TrueTrajectory(report["ground_truth"])
+    start = trajectory.at(0.0)
+
+    def error(t: float, x: float, y: float, theta: float) -> tuple[float, float]:
+        truth = trajectory.at(t)
+        world = start_to_world(start, np.array([[x, y]]))[0]
+        return (math.hypot(world[0] - truth.x, world[1] - truth.y),
+                math.degrees(abs(wrap_angle(theta + start.theta - truth.theta))))
+
+    over_time = np.array([error(*row[:4]) for row in track])
+    end = error(final["t"], final["x"], final["y"], final["theta"])
+    out: dict[str, Any] = {
+        "pose_error_m": end[0], "heading_error_deg": end[1],
+        "pose_error_max_m": float(max(over_time[:, 0].max(), end[0])),
+        "heading_error_max_deg": float(max(over_time[:, 1].max(), end[1])),
+        "pose_sigma_m": float(located.get("position_sigma_m", math.nan)),
+        "pose_ok": bool(end[0] <= POSE_GOAL[0] and end[1] <= POSE_GOAL[1]),
+    }
+    for t in TIMES:
+        before = np.flatnonzero(track[:, 0] <= t)
+        out[f"pose_error_at_{t:g}s_m"] = float(over_time[before[-1], 0]) if len(before) else None
+    return out
+
+
 def _first(curve: np.ndarray, level: float, column: int) -> float | None:
     hit = np.flatnonzero(curve[:, 2] >= level)
     return float(curve[hit[0], column]) if len(hit) else None
@@ -199,6 +305,7 @@ def episode_figures(report: dict[str, Any] | None, floor: FloorGrid, robot_radiu
         "wall_time_s": float(report.get("wall_time_s", math.nan)),
     }
     out["ok"] = bool(done and coverage >= GOAL and out["collisions"] == 0)
+    out.update(pose_errors(report))
     for d in DISTANCES:
         out[f"coverage_at_{d:g}m"] = _coverage_when(curve, d, 1)
     for t in TIMES:
@@ -237,6 +344,8 @@ CURVE_FIGURES = (  # per-episode figures averaged over a variant's runs and show
     *(f"path_to_{v * 100:g}pct_m" for v in LEVELS), *(f"time_to_{v * 100:g}pct_s" for v in LEVELS),
     "goal_count", "mode_switch_count", "gaze_watching_fraction", "gaze_look_ahead_fraction",
 )
+POSE_FIGURES = ("pose_error_m", "heading_error_deg", "pose_error_max_m", "heading_error_max_deg",
+                *(f"pose_error_at_{t:g}s_m" for t in TIMES), "pose_sigma_m")
 
 
 def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
@@ -253,11 +362,13 @@ def summarise_variant(runs: list[dict[str, Any]]) -> dict[str, Any]:
     if any(r["status"] == "ERROR" for r in runs):
         out["errors"] = sum(r["status"] == "ERROR" for r in runs)
     good = [r for r in runs if r["status"] != "ERROR"]
-    for key in ("coverage_map", "map_on_obstacles_m2", "path_length_m", "sim_time_s", *CURVE_FIGURES):
+    for key in ("coverage_map", "map_on_obstacles_m2", "path_length_m", "sim_time_s", *CURVE_FIGURES, *POSE_FIGURES):
         values = [r.get(key) for r in good]
         if good and any(key in r for r in good):
             out[key] = _mean(values)
     out.update(safety_totals(good))  # counts over the runs, not means; the smallest clearance
+    if any("pose_ok" in r for r in good):
+        out["pose_ok"] = sum(bool(r.get("pose_ok")) for r in good)
     return out
 
 
@@ -268,14 +379,16 @@ def _ratio(a: float | None, b: float | None) -> float | None:
 def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     """Run the episodes through the sweep runner and compute the figures."""
     floor = options.checked[0] if options.checked else check_world(options.world)
-    count = options.checked[1] if options.checked and options.checked[1] is not None else check_options(
+    settings = options.checked[1] if options.checked and options.checked[1] is not None else check_options(
         options.world, options.extra)
+    localisations, count = settings.localisations, settings.people
     world = load_world(options.world)
     where, people = seed_worlds(options.world, count, options.seeds, floor, Path(options.results_dir).resolve())
-    todo = episodes(where, options.seeds, options.max_time_s)
+    todo = episodes(where, options.seeds, options.max_time_s, settings.variants, localisations)
     rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,
                      progress=options.progress, resume=resume)
-    by_variant: dict[str, list[dict[str, Any]]] = {name: [] for name in VARIANTS}
+    by_variant: dict[str, list[dict[str, Any]]] = {column(name, loc): [] for loc in localisations
+                                                   for name in settings.variants}
     runs = []
     for row in rows:
         report = read_report(options.results_dir, row["id"])
@@ -293,28 +406,37 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     summary = {name: summarise_variant(v) for name, v in by_variant.items() if v}
     for name, figures in summary.items():
         out.update({f"{name}.{key}": value for key, value in figures.items()})
-    for other in ("fixed", "baseline"):
-        for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s"):
-            out[f"method_vs_{other}.{key}_ratio"] = _ratio(summary["method"].get(key), summary[other].get(key))
-        out[f"method_vs_{other}.path_length_ratio"] = _ratio(summary["method"].get("path_length_m"),
-                                                              summary[other].get("path_length_m"))
+    for loc in localisations:
+        method = summary.get(column("method", loc), {})
+        for other in [n for n in settings.variants if n != "method" and column(n, loc) in summary]:
+            versus, theirs = f"{column('method', loc)}_vs_{column(other, loc)}", summary[column(other, loc)]
+            for key in ("coverage_at_10m", "coverage_at_20m", "coverage_at_120s", "path_to_90pct_m",
+                        "path_to_95pct_m", "time_to_90pct_s", "time_to_95pct_s"):
+                out[f"{versus}.{key}_ratio"] = _ratio(method.get(key), theirs.get(key))
+            out[f"{versus}.path_length_ratio"] = _ratio(method.get("path_length_m"), theirs.get("path_length_m"))
+    if {"visual", "ideal"} <= set(localisations):  # what the oracle was worth
+        for name in [n for n in settings.variants if n in summary and column(n, "ideal") in summary]:
+            visual, ideal = summary[name], summary[column(name, "ideal")]
+            for key in ("map_on_obstacles_m2", "path_length_m"):
+                out[f"{name}_visual_vs_ideal.{key.rsplit('_', 1)[0]}_ratio"] = _ratio(visual.get(key), ideal.get(key))
     out["runs"] = sorted(runs, key=lambda r: (r["variant"], r["seed"]))
     return {**out, **crowd.figures(people, count)} if count else out
 
 
 def format_table(figures: dict[str, Any]) -> str:
     """The comparison as a readable table (one column per variant)."""
-    keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "collisions", "safety_stops", "min_clearance_m",
-            "path_length_m", "sim_time_s", *CURVE_FIGURES]
-    names = [n for n in VARIANTS if f"{n}.coverage" in figures]
+    keys = ["ok", "done", "coverage", "coverage_min", "coverage_map", "map_on_obstacles_m2", "collisions",
+            "safety_stops", "min_clearance_m", "path_length_m", "sim_time_s", *CURVE_FIGURES, "pose_ok", *POSE_FIGURES]
+    names = [column(n, loc) for loc in LOCALISATIONS for n in VARIANTS if f"{column(n, loc)}.coverage" in figures]
+    width = max(12, *(len(n) + 2 for n in names))
     lines = [f"exploration in {figures['world']}: {figures['seeds']} seed(s), reachable floor "
              f"{figures['reachable_area_m2']:.1f} m^2 ({figures['criterion']})",
-             "figure".ljust(24) + "".join(n.rjust(12) for n in names)]
+             "figure".ljust(24) + "".join(n.rjust(width) for n in names)]
     for key in keys:
         cells = []
         for name in names:
             value = figures.get(f"{name}.{key}")
             text = "-" if value is None else f"{value:.3g}" if isinstance(value, float) else str(value)
-            cells.append(text.rjust(12))
+            cells.append(text.rjust(width))
         lines.append(key.ljust(24) + "".join(cells))
     return "\n".join(lines + crowd.table_line(figures))

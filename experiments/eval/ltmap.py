@@ -36,6 +36,9 @@ Figures (simulator ground truth, evaluation only), per repeat:
   apart no finer than its spacing (indoors a few decimetres, outdoors metres, where far landmarks
   change slowly). ``--option goal_tolerance=M`` fixes it instead.
 - ``viewframes_reached``: fraction of the map's viewframes the repeat switched past.
+- ``estimates_pct``: per rule, the percentage of the repeat's estimates it made (``FollowRoute``'s
+  ``ltmap.estimates``: a rung of Z-infinity's far-threshold ladder, the compass, no rotation, lost).
+- ``bytes_per_m``: the map's bytes at this height per metre of the taught route (true length).
 
 Maps are written by the teach episodes into the results folder and read by the repeats and by
 this module: on a Dask cluster (``--cluster``) that folder (``-o DIR``) must be one the workers and
@@ -67,8 +70,10 @@ from drivers.sim.simulation import path_distances
 from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions
 from experiments.eval import people as crowd
-from experiments.eval.figures import cell, mean_present, safety_cells, safety_figures, safety_totals
-from experiments.eval.ltmap_route import Route, default_route, given_route, parse_route
+from experiments.eval.figures import cell, mean_present, safety_figures, safety_totals
+from experiments.eval.ltmap_route import Route, back_route, default_route, given_route, parse_route
+from experiments.eval.ltmap_table import estimate_shares, memory_limits, row_figures
+from experiments.eval.ltmap_table import format_table as format_table  # the area's table (experiments.eval)
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.table import read_report
@@ -80,8 +85,9 @@ DESCRIPTION = "teach and repeat: viewframe and path error, goal reached per LT-m
 OPTIONS = {
     "camera": "the camera the missions read: panorama (rendered images, ORB; default) or landmarks (ideal bearings); "
               "any panorama or bearings camera of the world",
-    "route": "the taught waypoints x0,y0,x1,y1,... (m, odometry frame of the world's start pose); "
-             "default: a tour of the free floor",
+    "route": "tour (default: a tour of the free floor), back (out along the tour and back past its bend: a route "
+             "that revisits places) or the taught waypoints x0,y0,x1,y1,... (m, odometry frame of the start pose)",
+    "gap_filling": "on (default) or off: the teach shifts landmarks found again to a common node (maps.ltmap.gaps)",
     "min_landmarks": "pruning deletes viewframes left with fewer landmarks (default: 50, or half the median "
                      "viewframe of a map with small viewframes)",
     "goal_tolerance": "m: the goal is reached when the repeat succeeds and ends this close to the route's start "
@@ -92,6 +98,8 @@ OPTIONS = {
 }
 ROTATIONS = ("zinf", "compass")
 TEACH, FOLLOW = "teach_route", "follow_route"
+TOUR, BACK = "tour", "back"
+ON_OFF = {"on": True, "off": False}
 CAMERA_KINDS = ("panorama", "bearings")
 SMALL_VIEWFRAME = 2 * DEFAULT_MIN_LANDMARKS  # landmarks: below this, min_landmarks is half the median viewframe
 REPEAT_TIME = (120.0, 4.0)  # s: a repeat's --max-time = a + b * the teach's sim time
@@ -107,6 +115,7 @@ class Settings:
     min_landmarks: int | None  # None: from the map (module docstring)
     goal_tolerance: float | None  # m; None: per seed from the robot and the map (module docstring)
     rotation: str = "zinf"  # FollowRoute's rotation estimate (ROTATIONS)
+    gap_filling: bool = True  # LearnRoute's gap filling (maps.ltmap.gaps)
     people: int = 0  # people in the repeats' world
 
 
@@ -127,7 +136,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
         usable = ", ".join(n for n, k in kinds.items() if k in CAMERA_KINDS) or "none"
         raise ValueError(f"camera: {camera!r} is not a panorama or bearings camera of world {loaded.name!r} "
                          f"(usable: {usable})")
-    route = given_route(loaded, parse_route(extra["route"])) if "route" in extra else default_route(loaded)
+    route = _route(loaded, extra.get("route", TOUR))
     min_landmarks = None
     if "min_landmarks" in extra:
         min_landmarks = _number(extra["min_landmarks"], "min_landmarks", int)
@@ -141,7 +150,20 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     rotation = extra.get("rotation", "zinf")
     if rotation not in ROTATIONS:
         raise ValueError(f"rotation must be one of {', '.join(ROTATIONS)}, got {rotation!r}")
-    return Settings(camera, route, min_landmarks, tolerance, rotation, crowd.parse_people(extra.get(crowd.OPTION)))
+    gap_filling = extra.get("gap_filling", "on")
+    if gap_filling not in ON_OFF:
+        raise ValueError(f"gap_filling must be on or off, got {gap_filling!r}")
+    return Settings(camera, route, min_landmarks, tolerance, rotation, ON_OFF[gap_filling],
+                    crowd.parse_people(extra.get(crowd.OPTION)))
+
+
+def _route(world: World, text: str) -> Route:
+    """The route an option names: the tour, out and back along it, or given waypoints."""
+    if text == TOUR:
+        return default_route(world)
+    if text == BACK:
+        return back_route(world)
+    return given_route(world, parse_route(text))
 
 
 def _number(text: str, name: str, kind: type[int] | type[float]) -> Any:
@@ -196,9 +218,12 @@ def levels(tree: LandmarkTree, min_landmarks: int) -> list[Level]:
 
 
 def teach_episode(world: str, seed: int, settings: Settings, folder: Path, max_time_s: float | None) -> Episode:
-    path = folder / MAPS / f"{Path(world).stem}_s{seed:04d}.ltmap"
+    path = folder / MAPS / f"{Path(world).stem}{'' if settings.gap_filling else '_nogaps'}_s{seed:04d}.ltmap"
     route = [round(v, 3) for v in settings.route.odometry]
-    return Episode(TEACH, world, seed, {"map": str(path), "camera": settings.camera, "route": route}, max_time_s)
+    inputs: dict[str, Any] = {"map": str(path), "camera": settings.camera, "route": route}
+    if not settings.gap_filling:  # only when not the default: the ids of the default's results stay
+        inputs["gap_filling"] = False
+    return Episode(TEACH, world, seed, inputs, max_time_s)
 
 
 def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_landmarks: int,
@@ -259,6 +284,12 @@ def viewframe_errors(teach: Run, repeat: Run) -> list[float]:
     return out
 
 
+def taught_length(teach: Run) -> float:
+    """The true length (m) of the taught route: the report's, else its decimated trajectory's."""
+    given = teach.report["ground_truth"].get("trajectory_length_m")
+    return float(given) if given is not None else float(teach.truth.length[-1])
+
+
 def repeat_figures(teach: Run, repeat: Mapping[str, Any] | None, level: Level,
                    tolerance: float) -> dict[str, Any]:
     """The figures of one repeat (module docstring); a repeat without a report reached nothing."""
@@ -283,39 +314,12 @@ def repeat_figures(teach: Run, repeat: Mapping[str, Any] | None, level: Level,
         "reached": bool(repeat["status"] == "SUCCESS" and safety["collisions"] == 0 and goal_error <= tolerance),
         "viewframes_reached": len(reached) / max(level.viewframes, 1),
         "recoveries": int(section.get("recoveries", 0)),
+        "estimates_pct": estimate_shares(section.get("estimates") or {}),
+        "bytes_per_m": level.bytes / length if (length := taught_length(teach)) > 0 else None,
         "sim_time_s": float(repeat.get("sim_time_s", 0.0)),
         "map_as_expected": section.get("height") == level.height and section.get("bytes") == level.bytes,
     })
     return out
-
-
-def row_figures(runs: list[dict[str, Any]]) -> dict[str, Any]:
-    """One Table-I row: means over the seeds' repeats of one number of levels cut."""
-    heights = sorted({r["height"] for r in runs})
-    good = [r for r in runs if r.get("status") != "ERROR"]
-    reached = [r for r in runs if r["reached"]]
-    row: dict[str, Any] = {
-        "levels_cut": runs[0]["cut"],
-        "height": heights[0] if len(heights) == 1 else None,
-        "height_range": [heights[0], heights[-1]],
-        "seeds": len(runs),
-        "viewframes": mean_present([r["viewframes"] for r in runs]),
-        "landmarks": mean_present([r["landmarks"] for r in runs]),
-        "bytes": mean_present([r["bytes"] for r in runs]),
-        "memory_pct": 100.0 * (mean_present([r["memory_fraction"] for r in runs]) or 0.0),
-        "viewframe_error_m": mean_present([r.get("viewframe_error_m") for r in good]),
-        "path_error_m": mean_present([r.get("path_error_m") for r in good]),
-        "path_error_reached_m": mean_present([r.get("path_error_m") for r in reached]),
-        "goal_error_m": mean_present([r.get("goal_error_m") for r in good]),
-        "goal_reached": len(reached),
-        "viewframes_reached_pct": 100.0 * (mean_present([r.get("viewframes_reached") for r in good]) or 0.0),
-        "recoveries": mean_present([r.get("recoveries") for r in good]),
-        "sim_time_s": mean_present([r.get("sim_time_s") for r in good]),
-        **safety_totals(good),
-    }
-    if len(good) < len(runs):
-        row["errors"] = len(runs) - len(good)
-    return row
 
 
 # ------------------------------------------------------------------------------------------------
@@ -379,6 +383,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
                            "height": tree.height, "bytes": tree.memory_bytes(), "min_landmarks": minimum,
                            "goal_tolerance_m": tolerance[seed],
                            "path_length_m": report["ground_truth"]["trajectory_length_m"],
+                           "shifted": report.get("ltmap", {}).get("shifted"),
+                           "loop_closures": report.get("ltmap", {}).get("loop_closures"),
                            "sim_time_s": report.get("sim_time_s"), **safety_figures(report)})
         plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation,
                                  repeat_world[seed]), taught, level) for level in levels(tree, minimum)]
@@ -422,6 +428,9 @@ def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dic
         "teach.height": mean_present([t["height"] for t in teach_rows]),
         "teach.bytes": mean_present([t["bytes"] for t in teach_rows]),
         "teach.path_length_m": mean_present([t["path_length_m"] for t in teach_rows]),
+        "gap_filling": settings.gap_filling,
+        "teach.shifted": mean_present([t.get("shifted") for t in teach_rows]),
+        "teach.loop_closures": mean_present([t.get("loop_closures") for t in teach_rows]),
         **{f"teach.{k}": v for k, v in safety_totals(teach_rows).items()},
         "min_landmarks": sorted({t["min_landmarks"] for t in teach_rows}),
         "repeats": len(runs),
@@ -439,50 +448,3 @@ def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dic
     if any(not r.get("map_as_expected", True) for r in runs):
         out["warning"] = "some repeats followed a map other than the height planned (see runs[].map_as_expected)"
     return out
-
-
-def memory_limits(rows: list[dict[str, Any]]) -> dict[str, float | None]:
-    """As the paper puts it ("goal still reached at 57 % memory, lost at 35 %"): going down from the
-    full tree, the memory of the last row where every taught seed reached the goal, and of the first
-    row where one did not (None: no such row)."""
-    still, lost = None, None
-    for row in rows:  # a row of fewer seeds (their trees were not that tall) counts by the seeds it has
-        if row["goal_reached"] == row["seeds"]:
-            still = row["memory_pct"]
-        else:
-            lost = row["memory_pct"]
-            break
-    return {"goal_reached_down_to_memory_pct": still, "goal_first_missed_memory_pct": lost}
-
-
-def format_table(figures: Mapping[str, Any]) -> str:
-    """The rows as the paper's Table I, with the setting above them."""
-    route = f"{figures['route_source']} of {figures['route_length_m']:.1f} m"
-    lines = [
-        f"LT-map teach and repeat in {figures['world']}: {figures['seeds']} seed(s), camera {figures['camera']}, "
-        f"rotation {figures.get('rotation', 'zinf')}, route: {route}, taught {figures['taught']}/{figures['seeds']}",
-        f"goal reached: {figures['criterion']}; min_landmarks {figures['min_landmarks']}; path error of the repeats "
-        "that reached the goal (of all repeats)",
-        f"{'height':>6} {'cut':>3} {'viewframes':>10} {'landmarks':>9} {'memory %':>8} {'vf err m':>8} "
-        f"{'path err m':>16} {'goal err m':>10} {'vf reached %':>12} {'goal reached':>12}  obstacles",
-    ]
-    for row in figures["rows"]:
-        low, high = row["height_range"]
-        height = str(low) if low == high else f"{low}-{high}"
-        path = f"{cell(row['path_error_reached_m'])} ({cell(row['path_error_m'])})"
-        lines.append(f"{height:>6} {row['levels_cut']:>3} {cell(row['viewframes'], 1):>10} "
-                     f"{cell(row['landmarks'], 0):>9} {cell(row['memory_pct'], 1):>8} "
-                     f"{cell(row['viewframe_error_m']):>8} {path:>16} {cell(row['goal_error_m']):>10} "
-                     f"{cell(row['viewframes_reached_pct'], 0):>12} {row['goal_reached']:>7} of {row['seeds']}"
-                     f"  {safety_cells(row)}" + (f"  ({row['errors']} errors)" if row.get("errors") else ""))
-    still, lost = figures.get("goal_reached_down_to_memory_pct"), figures.get("goal_first_missed_memory_pct")
-    if figures["rows"]:
-        lines.append(f"goal reached by every seed down to {cell(still, 1)} % memory; first missed at "
-                     f"{cell(lost, 1)} %")
-    lines.append(f"teaching: {safety_cells({k[6:]: v for k, v in figures.items() if k.startswith('teach.')})}")
-    lines += crowd.table_line(figures)
-    for fail in figures["teach_failed"]:
-        lines.append(f"seed {fail['seed']}: no map to repeat ({fail['problem']})")
-    if figures.get("warning"):
-        lines.append(f"warning: {figures['warning']}")
-    return "\n".join(lines)

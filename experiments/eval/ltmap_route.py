@@ -26,6 +26,14 @@ at. The default tour, from the world's true start pose S:
 4. The polyline, start excluded, in the **odometry frame of the start pose** (x ahead, y left,
    origin at S): the ``route`` input of ``teach_route`` (DriveWaypoints drives it on odometry).
 
+**A route that revisits** (``--option route=back``): the default tour driven out to its end E and
+back along itself (the same planned legs, reversed, so just as clear) to the point a third of the
+tour's length from S. The way back passes every place of the last two thirds of the tour again,
+the bend among them, facing the other way (bearings are compensated for the heading, so a place
+is a place): the map sees its far landmarks again and, with gap filling, reports the loops. It
+ends away from its start (a third of the tour along the floor), so a repeat that never moves
+cannot look home; any world with a default tour has one.
+
 Given waypoints (``--option route=x0,y0,...``, odometry frame as ``teach_route`` takes them) are
 checked the same way: every waypoint and every straight leg on the reachable floor.
 """
@@ -57,6 +65,7 @@ MIN_BEND = 0.3  # m off the line S-E: a smaller bend is dropped
 PLAN_SAFETY = 0.1  # m: legs are planned for the robot's radius plus this
 WINDOW = DETOUR * REACH + 1.5  # m: half the side of the floor window around the start
 ROUTE_WINDOW_MARGIN = 1.5  # m around given waypoints
+BACK_TO = 1.0 / 3.0  # the route back along the tour ends this fraction of the tour's length from the start
 
 
 @dataclass(frozen=True)
@@ -66,7 +75,7 @@ class Route:
 
     world_xy: np.ndarray
     odometry: list[float]
-    source: str  # "tour" (the default) or "given"
+    source: str  # "tour" (the default), "back" (out and back along the tour) or "given"
     margin_m: float | None  # the tour's clearance margin; None for given waypoints
 
     @property
@@ -158,6 +167,20 @@ def default_route(world: World) -> Route:
     raise ValueError(f"no room for a route: the floor the robot reaches from the start ({start.x:g}, {start.y:g}) "
                      f"goes less than {MIN_END:g} m with {MARGINS[-1]:g} m of clearance; give waypoints with "
                      "--option route=x0,y0,...")
+
+
+def back_route(world: World) -> Route:
+    """Out along the default tour and back along it to a third of its length (module docstring)."""
+    tour = default_route(world)
+    way = tour.world_xy
+    steps = np.hypot(*np.diff(way, axis=0).T)
+    along = np.concatenate(([0.0], np.cumsum(steps)))
+    stop = BACK_TO * along[-1]
+    k = int(np.searchsorted(along, stop, side="right"))  # way[k - 1] .. way[k] holds the stop
+    t = (stop - along[k - 1]) / max(float(steps[k - 1]), 1e-12)
+    end = way[k - 1] + t * (way[k] - way[k - 1])
+    points = np.vstack((way, way[-2:k - 1:-1] if k < len(way) - 1 else np.zeros((0, 2)), [end]))
+    return Route(points, world_to_start(world.start, points[1:]).ravel().tolist(), "back", tour.margin_m)
 
 
 def _tour(floor: Floor, from_start: np.ndarray, start: Pose2D, margin: float, radius: float) -> np.ndarray | None:

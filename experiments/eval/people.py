@@ -32,6 +32,7 @@ import yaml
 from drivers.sim.floor import FloorGrid
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, shipped_worlds
+from experiments.eval import count_option
 
 MAX_PEOPLE = 20
 OPTION = "people"
@@ -50,15 +51,7 @@ STEP = 0.05  # m: how finely a walk is checked against the surfaces
 
 def parse_people(text: str | None) -> int:
     """The ``people`` option: 0 to :data:`MAX_PEOPLE` (default 0); ``ValueError`` otherwise."""
-    if text is None:
-        return 0
-    try:
-        count = int(text)
-    except ValueError:
-        raise ValueError(f"people: an integer expected, got {text!r}") from None
-    if not 0 <= count <= MAX_PEOPLE:
-        raise ValueError(f"people must be 0 to {MAX_PEOPLE}, got {count}")
-    return count
+    return count_option("people", text, default=0, maximum=MAX_PEOPLE)
 
 
 @dataclass(frozen=True)

@@ -65,7 +65,7 @@ import numpy as np
 
 from drivers.sim.floor import FloorGrid
 from drivers.sim.world import World, load_world
-from experiments.eval import EvalOptions
+from experiments.eval import EvalOptions, count_option
 from experiments.eval import people as crowd
 from experiments.eval.figures import cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.roadmap_world import (
@@ -191,15 +191,7 @@ def placed_names(count: int) -> tuple[str, ...]:
 
 def parse_starts(text: str | None) -> int:
     """The ``starts`` option: 0 to ``MAX_STARTS`` (default ``DEFAULT_STARTS``)."""
-    if text is None:
-        return DEFAULT_STARTS
-    try:
-        starts = int(text)
-    except ValueError:
-        raise ValueError(f"starts: an integer expected, got {text!r}") from None
-    if not 0 <= starts <= MAX_STARTS:
-        raise ValueError(f"starts must be 0 to {MAX_STARTS}, got {starts}")
-    return starts
+    return count_option("starts", text, default=DEFAULT_STARTS, maximum=MAX_STARTS)
 
 
 def parse_targets(text: str, world: World, usable: Mapping[str, Pose2D]) -> tuple[str, ...]:

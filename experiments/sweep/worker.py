@@ -153,16 +153,19 @@ def _run_spawned(argv: list[str], log: Path, started: float, timeout_s: float | 
 def _run_forked(server: _Server | None, argv: list[str], log: Path, started: float, timeout_s: float | None,
                 stop: StopToken | None) -> tuple[int | None, str | None] | None:
     """The episode forked from this thread's warm server (started again once if it dies under
-    the episode); None if there is no server to use."""
+    the episode, unless the sweep was stopped or the time is up meanwhile: a server that was slow
+    to kill an episode on a loaded machine must not start it again); None if there is no server
+    to use."""
     for attempt in (1, 2):
         if server is None:
             return None
         try:
             return server.run(argv, log, started, timeout_s, stop)
         except _ServerLost:
-            _Server.drop()
-            if attempt == 2:
-                return None, "lost"
+            _Server.drop()  # its episode goes with it
+            ended_by = _must_end(started, timeout_s, stop)
+            if attempt == 2 or ended_by:  # a stopped sweep or a spent time limit starts nothing again
+                return None, ended_by or "lost"
             server = _Server.get()
     return None
 

@@ -52,6 +52,15 @@ Choices where the paper is vague:
   still attract.
 - ``closest_frontier``: frontier mode always: the closest reachable border point (Yamauchi's
   frontier exploration, the evaluation's baseline; explore_lite also weighs a frontier's size).
+- ``nearby`` (finite; the mission's default strategy ``nearby_attraction``): eq. 1 chooses only
+  among the points whose border point ``P_b`` costs at most ``nearby`` metres more to reach than
+  the closest reachable border point; other points do not attract (power -inf), and without one
+  beyond K the robot is in frontier mode. Eq. 1 over all points (``nearby`` inf: the paper, the
+  strategy ``attraction``) goes after far points first: in the flat of ``rooms`` a point's d
+  reached 9-11 m (points behind walls or outside the building, whose nearest *reachable* border is
+  rooms away), so A_P = d - eta G chose borders 15-18 m away over one next to the robot, and the
+  robot crossed the flat and came back. Closest-frontier order with eq. 1 among near equals keeps
+  the sweep and still prefers the border with the most unknown behind it (docs/exploration.md).
 """
 
 from __future__ import annotations
@@ -94,14 +103,15 @@ class GoalParams:
     point_clearance: float = 0.0  # m: points whose floor projection is this close to an obstacle cell do not attract
     verify_radius: float = 0.0  # m: > 0: before DONE, look again at what closes a border a disc this size reaches
     look_back: float = 1.0  # m: ...from this far before the first cell the robot's own disc cannot pass
+    nearby: float = math.inf  # m: only points whose border costs at most this more than the closest one attract
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.eta <= 0.5:
             raise ValueError(f"eta must be in [0, 0.5] (eq. 1), got {self.eta}")
         if min(self.k, self.robot_radius, self.min_frontier, self.margin, self.penalty, self.hysteresis,
-               self.avoid_radius, self.point_clearance, self.verify_radius, self.look_back) < 0.0:
+               self.avoid_radius, self.point_clearance, self.verify_radius, self.look_back, self.nearby) < 0.0:
             raise ValueError("k, robot_radius, min_frontier, margin, penalty, hysteresis, avoid_radius, "
-                             "point_clearance, verify_radius and look_back must not be negative")
+                             "point_clearance, verify_radius, look_back and nearby must not be negative")
         if self.patience < 1:
             raise ValueError(f"patience must be at least 1, got {self.patience}")
 
@@ -158,7 +168,8 @@ class Candidates:
 
     ``border`` (B x 2) reachable border points and their travel cost ``border_cost`` (B,);
     per map point: ``distance`` d to its nearest reachable border point ``nearest`` (index into
-    ``border``, -1 without any) and the attractive power ``power`` (eq. 1; -inf without a border).
+    ``border``, -1 without any) and the attractive power ``power`` (eq. 1; -inf without a border, and
+    for points whose border point is not ``nearby``).
     """
 
     border: np.ndarray
@@ -213,6 +224,8 @@ def candidates(
         eligible &= room > params.point_clearance
     distance = np.where(eligible, distance, 0.0)
     power = attractive_power(distance, border_cost[nearest], params.eta)
+    if math.isfinite(params.nearby):  # eq. 1 among the border points about as close as the closest
+        power = np.where(border_cost[nearest] <= border_cost.min() + params.nearby, power, -np.inf)
     return Candidates(border, border_cost, distance, np.asarray(nearest, dtype=np.int64), power, travel)
 
 
@@ -238,7 +251,7 @@ def select_goal(
     if switch.mode is Mode.DONE:
         return switch, None
     found = candidates(m, robot, params, avoid, travel=travel)
-    eligible = found.distance > params.k
+    eligible = (found.distance > params.k) & np.isfinite(found.power)
     if switch.spent:
         eligible[np.fromiter(switch.spent, dtype=np.int64)] = False
     if params.closest_frontier:

@@ -1,10 +1,14 @@
-"""LT-map files: a :class:`~maps.ltmap.tree.LandmarkTree` saved as map kind ``ltmap``, format version 1.
+"""LT-map files: a :class:`~maps.ltmap.tree.LandmarkTree` saved as map kind ``ltmap``, format version 2.
 
 The container (magic line, JSON header with length and SHA-256, ``.npz`` payload, atomic write)
 is :mod:`maps.mapfile`'s; the payload holds exactly :meth:`LandmarkTree.to_arrays`, so a map's
 ``memory_bytes()`` is what its arrays take in the file, and the header's ``meta`` holds what is
-not an array: the landmark kind and the eq. 1 threshold the route was taught with (route
-following switches viewframes at the same value). A damaged, truncated, foreign or inconsistent
+not an array: the landmark kind, the eq. 1 threshold the route was taught with (route
+following switches viewframes at the same value) and eq. 1's scale ``b``. Version 1 files hold
+a threshold of the earlier form of eq. 1 (the Pseudo-Huber cost of the angle, delta 2 deg) and
+no scale: they are read with the eq. 1 threshold of the same bearing change
+(:func:`perception.similarity.angle_form_threshold_angle`; 1e-3 becomes the cost of 3.04 deg).
+A damaged, truncated, foreign or inconsistent
 file is one :class:`~maps.store.InputError` line, and a failed save leaves the previous file.
 """
 
@@ -18,9 +22,11 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from maps.ltmap.tree import LandmarkTree
 from maps.mapfile import MapFile, decode_map, encode_map, read_map_file, write_map_file
 from maps.store import Diagnostic, InputError
+from perception.similarity import DEFAULT_SCALE, angle_form_threshold_angle, cost_of_angle
 
 KIND = "ltmap"
-VERSION = 1
+VERSION = 2
+ANGLE_FORM_VERSION = 1  # thresholds of the earlier form of eq. 1, read converted
 
 
 class LtmapMeta(BaseModel):
@@ -29,11 +35,12 @@ class LtmapMeta(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     landmarks: Literal["ids", "orb", "brisk", "sift"] = Field(description="descriptor kind, or ids (ideal sensor)")
-    threshold: float = Field(gt=0, allow_inf_nan=False, description="eq. 1 threshold the route was taught with [rad^2]")
+    threshold: float = Field(gt=0, allow_inf_nan=False, description="eq. 1 threshold the route was taught with")
+    scale: float = Field(DEFAULT_SCALE, gt=0, allow_inf_nan=False, description="eq. 1's b (a cosine distance)")
 
 
 def _meta(tree: LandmarkTree) -> dict:
-    return LtmapMeta(landmarks=tree.kind, threshold=tree.threshold).model_dump()
+    return LtmapMeta(landmarks=tree.kind, threshold=tree.threshold, scale=tree.scale).model_dump()
 
 
 def encode_ltmap(tree: LandmarkTree) -> bytes:
@@ -48,12 +55,12 @@ def save_ltmap(path: str | os.PathLike, tree: LandmarkTree) -> None:
 
 def decode_ltmap(data: bytes, *, file: str) -> LandmarkTree:
     """An LT-map from file bytes; one-line :class:`InputError` naming ``file`` when they are not one."""
-    return _tree(decode_map(data, file=file, kind=KIND, versions=(VERSION,)), file)
+    return _tree(decode_map(data, file=file, kind=KIND, versions=(ANGLE_FORM_VERSION, VERSION)), file)
 
 
 def load_ltmap(path: str | os.PathLike) -> LandmarkTree:
     """Load an LT-map file, checking container, header and the tree's consistency."""
-    return _tree(read_map_file(path, kind=KIND, versions=(VERSION,)), str(path))
+    return _tree(read_map_file(path, kind=KIND, versions=(ANGLE_FORM_VERSION, VERSION)), str(path))
 
 
 def _tree(loaded: MapFile, file: str) -> LandmarkTree:
@@ -62,7 +69,10 @@ def _tree(loaded: MapFile, file: str) -> LandmarkTree:
     except ValidationError as exc:
         where = ".".join(str(part) for part in exc.errors()[0]["loc"]) or "meta"
         raise InputError([Diagnostic(file, 0, 0, f"damaged LT-map: bad header meta ({where})")]) from None
+    threshold = meta.threshold
+    if loaded.header.version == ANGLE_FORM_VERSION:
+        threshold = cost_of_angle(angle_form_threshold_angle(threshold), meta.scale)
     try:
-        return LandmarkTree.from_arrays(loaded.arrays, kind=meta.landmarks, threshold=meta.threshold)
+        return LandmarkTree.from_arrays(loaded.arrays, kind=meta.landmarks, threshold=threshold, scale=meta.scale)
     except ValueError as exc:
         raise InputError([Diagnostic(file, 0, 0, f"damaged LT-map: {exc}")]) from None

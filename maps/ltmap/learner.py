@@ -14,16 +14,26 @@ with the camera's heading; it decides where viewframes are and hands the tree
   against the viewframe's cached landmark stack. Features that match no viewframe landmark are
   candidates for the next viewframe; candidates not matched against the previous image are
   *volatile* and rejected.
-- **New viewframe** when ``delta_t`` (eq. 1, :func:`perception.similarity.delta_t`: mean
-  Pseudo-Huber cost of bearing changes) of the landmarks tracked since the last viewframe
-  exceeds the threshold. The change is measured from the bearings they had when that viewframe
-  was made (the learner keeps them), so ``delta_t`` starts at 0 at every viewframe. Nothing
+- **New viewframe** when ``delta_t`` (eq. 1 as written, :func:`perception.similarity.delta_t`:
+  the mean Pseudo-Huber cost of ``1 - l^T l'``) of the landmarks tracked since the last viewframe
+  exceeds the threshold (by default the cost of a 3 deg bearing change). It is measured as route
+  following measures it (:func:`perception.viewframe_motion.change_since`): over Z-infinity's
+  inliers between the bearings then and now, its rotation removed. Eq. 1 weighs a mismatched
+  landmark up to 2000 times a 3 deg change, and with descriptors a single mismatch among
+  hundreds of tracked landmarks made almost every viewframe outdoors; the inliers leave it out.
+  Fewer tracked landmarks than Z-infinity needs: eq. 1 over all of them. The change is measured
+  from the bearings they had when that viewframe was made (the learner keeps them), so
+  ``delta_t`` starts at 0 at every viewframe. Nothing
   tracked is ``inf``: losing every landmark also makes a viewframe (but seeing nothing at all,
   say in the dark, makes no empty ones).
 - **Share angle.** A tracked landmark is shared with the new viewframe only while its current
   bearing stays within ``share_angle`` of the stored one; by default the angle whose eq. 1 cost
-  equals the threshold (:func:`threshold_angle`, about 3 deg), so that at a viewframe's own
+  equals the threshold (:func:`threshold_angle`, 3 deg by default), so that at a viewframe's own
   place ``delta_t`` stays under the threshold and route following can switch there.
+- **Gap filling** (``gap_filling``, on by default): after each new viewframe its landmarks are
+  looked for among the map's other rows; one found again within ``share_angle`` is shifted to
+  the common node of its two copies, and a route back past an earlier place is reported as a
+  loop (:mod:`maps.ltmap.gaps` says how the paper is read there).
 - **Online pruning.** With a memory budget the map is pruned whenever it outgrows it
   (:mod:`maps.ltmap.prune`), so the route's length need not be known in advance.
 """
@@ -36,11 +46,13 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from maps.ltmap.arrays import IDS
+from maps.ltmap.gaps import DEFAULT_GAPS, GapConfig, GapFill, Loop
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS, PruneReport
-from maps.ltmap.tree import DEFAULT_THRESHOLD, LandmarkSet, LandmarkTree
+from maps.ltmap.tree import LandmarkSet, LandmarkTree
 from perception.matching import LandmarkMatches, match_features
 from perception.observation import Observation
-from perception.similarity import DEFAULT_SCALE, delta_t
+from perception.similarity import DEFAULT_SCALE, angle_of_cost, default_threshold, delta_t
+from perception.viewframe_motion import ZINF_MIN_LANDMARKS, change_since, zinf_motion
 
 
 def compensate(bearings: np.ndarray, heading: float) -> np.ndarray:
@@ -51,18 +63,21 @@ def compensate(bearings: np.ndarray, heading: float) -> np.ndarray:
 
 @dataclass(frozen=True, slots=True)
 class LearnConfig:
-    """How a route is taught: the eq. 1 ``threshold`` (rad^2) and Pseudo-Huber ``scale`` (rad), the
-    ``share_angle`` (rad) within which a tracked landmark keeps its stored bearing and is shared
-    (None: the angle whose eq. 1 cost is the threshold), the matching ``ratio`` (None: the kind's
-    default), an optional memory budget (bytes, pruned online) and the smallest viewframe
-    pruning keeps."""
+    """How a route is taught: the eq. 1 ``threshold`` (None: the cost of a 3 deg bearing change at
+    ``scale``) and eq. 1's ``scale`` ``b``, the ``share_angle`` (rad) within which a tracked
+    landmark keeps its stored bearing and is shared (None: the angle whose eq. 1 cost is the
+    threshold), the matching ``ratio`` (None: the kind's default), an optional memory budget
+    (bytes, pruned online), the smallest viewframe pruning keeps, and whether landmarks found
+    again are shifted to a common node (``gap_filling``, with ``gaps``: :mod:`maps.ltmap.gaps`)."""
 
-    threshold: float = DEFAULT_THRESHOLD
+    threshold: float | None = None
     scale: float = DEFAULT_SCALE
     share_angle: float | None = None
     ratio: float | None = None
     budget_bytes: int | None = None
     min_landmarks: int = DEFAULT_MIN_LANDMARKS
+    gap_filling: bool = True
+    gaps: GapConfig = DEFAULT_GAPS
 
     def __post_init__(self) -> None:
         for name in ("threshold", "scale", "share_angle"):
@@ -74,10 +89,15 @@ class LearnConfig:
         if self.min_landmarks < 0:
             raise ValueError(f"min_landmarks must be >= 0, got {self.min_landmarks}")
 
+    @property
+    def eq1_threshold(self) -> float:
+        """The threshold in use: the one given, or the cost of a 3 deg change at ``scale``."""
+        return default_threshold(self.scale) if self.threshold is None else self.threshold
+
 
 def threshold_angle(threshold: float, scale: float = DEFAULT_SCALE) -> float:
-    """The bearing change (rad) whose eq. 1 cost is ``threshold``: the inverse of the Pseudo-Huber cost."""
-    return float(scale * np.sqrt((1.0 + threshold / scale**2) ** 2 - 1.0))
+    """The bearing change (rad) whose eq. 1 cost is ``threshold``: the inverse of the cost."""
+    return angle_of_cost(threshold, scale)
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,7 +109,8 @@ class LearnStep:
     there was none); ``tracked``: landmarks of the previous viewframe seen now; ``stored``:
     landmarks stored in the new leaf (new ones and sightings not shared); ``volatile``: features
     rejected because the previous image lacked them; ``pruned``: the online pruning this step
-    ran (a budget is set and was exceeded).
+    ran (a budget is set and was exceeded); ``shifted``: landmarks found again and merged into a
+    common node (gap filling); ``loop``: the loop this viewframe closed.
     """
 
     viewframe: int
@@ -99,6 +120,8 @@ class LearnStep:
     stored: int = 0
     volatile: int = 0
     pruned: PruneReport | None = None
+    shifted: int = 0
+    loop: Loop | None = None
 
     @property
     def over_budget(self) -> bool:
@@ -146,13 +169,15 @@ class RouteLearner:
         self._before: _Seen | None = None
         self._at_viewframe = False
         self._anchor = _Anchor()
+        self._rng = np.random.default_rng(0)  # Z-infinity's RANSAC: the same route teaches the same map
         angle = self.config.share_angle
-        self.share_angle = threshold_angle(self.config.threshold, self.config.scale) if angle is None else angle
+        self.threshold = self.config.eq1_threshold
+        self.share_angle = threshold_angle(self.threshold, self.config.scale) if angle is None else angle
 
     def observe(self, observation: Observation, heading: float) -> LearnStep:
         """One new observation, seen with the camera at ``heading`` (rad) in the route frame."""
         if self.tree is None:
-            self.tree = LandmarkTree(_kind_of(observation), threshold=self.config.threshold)
+            self.tree = LandmarkTree(_kind_of(observation), threshold=self.threshold, scale=self.config.scale)
         tree, seen = self.tree, _Seen(observation, compensate(observation.bearings, heading))
         self._before, self._latest = self._latest, seen
         if tree.viewframe_count == 0:
@@ -162,7 +187,7 @@ class RouteLearner:
             return self._make_viewframe(tree, seen, np.inf, 0)
         tracked = self._track(tree, seen)
         change, count = self._change(tracked)
-        self._at_viewframe = change > self.config.threshold
+        self._at_viewframe = change > self.threshold
         if self._at_viewframe:
             return self._make_viewframe(tree, seen, change, count, tracked)
         return LearnStep(tree.viewframe_count - 1, False, change, count)
@@ -185,10 +210,14 @@ class RouteLearner:
         return _Tracked(matches, tree.viewframe(-1).landmarks[matches.landmark])
 
     def _change(self, tracked: _Tracked) -> tuple[float, int]:
-        """Eq. 1 over the landmarks tracked since the last viewframe, from their bearings then."""
+        """Eq. 1 over the landmarks tracked since the last viewframe, from their bearings then
+        (over Z-infinity's inliers when there are enough for it: see the module doc)."""
         _, then, now = np.intersect1d(self._anchor.landmarks, tracked.landmarks, return_indices=True)
-        change = delta_t(self._anchor.bearings[then], tracked.matches.cur[now], scale=self.config.scale)  # eq. 1
-        return change, len(then)
+        ref, cur = self._anchor.bearings[then], tracked.matches.cur[now]
+        if len(then) < ZINF_MIN_LANDMARKS:
+            return delta_t(ref, cur, scale=self.config.scale), len(then)  # eq. 1
+        motion = zinf_motion(ref, cur, self._rng).motion
+        return change_since(ref, cur, motion, self.config.scale), len(then)
 
     def _make_viewframe(self, tree: LandmarkTree, seen: _Seen, change: float, count: int,
                         tracked: _Tracked | None = None) -> LearnStep:
@@ -208,8 +237,20 @@ class RouteLearner:
         stored = np.arange(before, tree.landmark_count)
         self._anchor = _Anchor(np.concatenate((landmarks, stored)),
                                np.vstack((sightings.bearings, tree.bearings[stored])))
+        filled = self._fill_gaps(tree)
+        stored_now = len(tree.node_landmarks(tree.viewframe_leaves[-1]))  # gap filling may have merged some away
         pruned = self._prune_online(tree)
-        return LearnStep(tree.viewframe_count - 1, True, float(change), count, len(stored), volatile, pruned)
+        return LearnStep(tree.viewframe_count - 1, True, float(change), count, stored_now, volatile, pruned,
+                         filled.shifted if filled else 0, filled.loop if filled else None)
+
+    def _fill_gaps(self, tree: LandmarkTree) -> GapFill | None:
+        if not self.config.gap_filling:
+            return None
+        filled = tree.fill_gaps(self.share_angle, self.config.gaps, ratio=self.config.ratio)
+        if filled.shifted:  # the anchor follows: a deleted copy is its kept twin now (once)
+            landmarks, first = np.unique(filled.landmark_index[self._anchor.landmarks], return_index=True)
+            self._anchor = _Anchor(landmarks, self._anchor.bearings[first])
+        return filled
 
     def _prune_online(self, tree: LandmarkTree) -> PruneReport | None:
         budget = self.config.budget_bytes

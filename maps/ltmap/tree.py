@@ -40,6 +40,10 @@ short-lived local ones near the leaves. Pure: numpy arrays and dataclasses, no I
   that tracked it. On a synthetic corridor (tests, benchmark) over 99% of a viewframe's
   landmarks are visible from it within 5 deg of their stored bearing, for 5-10% more memory
   than moving every tracked landmark up (which leaves about a third of them wrong).
+- **Gap filling** (:meth:`LandmarkTree.fill_gaps`, :mod:`maps.ltmap.gaps`): a landmark stored
+  twice within ``share_angle`` (it dropped out of tracking and was stored again) becomes one, in
+  the common node of its two copies, when that node gives it only to a short gap of viewframes
+  between its sightings. With it, a viewframe may hold a landmark it did not see in that gap.
 - **Memory** (:meth:`LandmarkTree.memory_bytes`) is exactly what :meth:`LandmarkTree.to_arrays`
   holds (:mod:`maps.ltmap.arrays`).
 """
@@ -65,6 +69,7 @@ from maps.ltmap.arrays import (
     preorder,
     readonly,
 )
+from maps.ltmap.gaps import DEFAULT_GAPS, GapConfig, GapFill, found_again, plan_shifts
 from maps.ltmap.matching import Viewframe, ViewframeCache, match_viewframe, stack_viewframe
 from maps.ltmap.prune import (
     DEFAULT_MIN_LANDMARKS,
@@ -78,10 +83,9 @@ from maps.ltmap.prune import (
 )
 from perception.matching import LandmarkMatches
 from perception.observation import Observation
-from perception.similarity import bearing_angles
+from perception.similarity import DEFAULT_SCALE, bearing_angles, default_threshold
 
-# eq. 1 threshold (rad^2; mean Pseudo-Huber cost, delta 2 deg): about 3 deg of mean bearing change
-DEFAULT_THRESHOLD = 1.0e-3
+DEFAULT_THRESHOLD = default_threshold()  # eq. 1: the cost of a 3 deg bearing change (1.085e-6)
 NO_GATE = float("inf")  # share every tracked landmark, whatever its bearing now
 
 
@@ -157,6 +161,19 @@ def attach_level(lost: np.ndarray, tracked: np.ndarray, leaves: np.ndarray) -> i
     return int(len(cost) - 1 - np.argmin(cost[::-1]))
 
 
+def _resolve(index: np.ndarray, alive: np.ndarray) -> np.ndarray:
+    """``index`` holds, for a deleted row, the OLD row it merged into (which may be deleted too):
+    follow to a surviving row and give its new index."""
+    renumbered = np.where(alive, np.cumsum(alive) - 1, -1)
+    out = renumbered.copy()
+    for row in np.flatnonzero(~alive).tolist():
+        target = int(index[row])
+        while not alive[target]:
+            target = int(index[target])
+        out[row] = renumbered[target]
+    return out
+
+
 @dataclass
 class _Rows:
     """The landmark rows of a tree (mutable storage): node, unit bearing, and ``data``, the
@@ -182,12 +199,14 @@ class LandmarkTree:
     path of route following, cached per viewframe).
     """
 
-    def __init__(self, kind: str, *, threshold: float = DEFAULT_THRESHOLD) -> None:
+    def __init__(self, kind: str, *, threshold: float = DEFAULT_THRESHOLD, scale: float = DEFAULT_SCALE) -> None:
         check_kind(kind)
-        if not (np.isfinite(threshold) and threshold > 0):
-            raise ValueError(f"threshold must be a positive number, got {threshold}")
+        for name, value in (("threshold", threshold), ("scale", scale)):
+            if not (np.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a positive number, got {value}")
         self.kind = kind
         self.threshold = float(threshold)
+        self.scale = float(scale)  # eq. 1's b: delta_t against ``threshold`` is measured with it
         self._parent: list[int] = []
         self._leaves: list[int] = []
         self._rows = _Rows(np.zeros(0, dtype=np.int64), np.zeros((0, 3), dtype=BEARING_DTYPE), empty_data(kind))
@@ -343,6 +362,27 @@ class LandmarkTree:
         self._cache.clear()
         return len(self._leaves) - 1
 
+    def fill_gaps(self, share_angle: float, config: GapConfig = DEFAULT_GAPS, *,
+                  ratio: float | None = None) -> GapFill:
+        """Find the last viewframe's landmarks again among the map's other rows and shift each found
+        within ``share_angle`` to the common node of its two copies (:mod:`maps.ltmap.gaps`)."""
+        if not self._leaves:
+            return GapFill(0, 0, None, np.arange(0))
+        candidates = np.flatnonzero(np.isin(self._rows.node, self.branch_nodes(-1)))
+        pairs = found_again(self.kind, self._rows.data, self._rows.bearings, candidates, share_angle, ratio=ratio)
+        plan = plan_shifts(self._parent, self._leaves, self._rows.node, pairs, config, viewframe_size=len(candidates))
+        index = np.arange(self.landmark_count)
+        if len(plan.drop):
+            self._rows.node[plan.keep] = plan.node
+            alive = np.ones(self.landmark_count, dtype=bool)
+            alive[plan.drop] = False
+            merged_into = np.arange(self.landmark_count)
+            merged_into[plan.drop] = plan.keep  # a kept row may itself merge later in the batch: _resolve follows
+            index = _resolve(merged_into, alive)
+            self._rows = self._rows.take(alive)
+            self._cache.clear()
+        return GapFill(len(pairs), len(plan.drop), plan.loop, index)
+
     def _check_rows(self, new: LandmarkSet) -> None:
         data = new.ids if self.kind == IDS else new.descriptors
         if data is None:
@@ -455,7 +495,7 @@ class LandmarkTree:
 
     def copy(self) -> LandmarkTree:
         """An independent copy (its own arrays and cache)."""
-        twin = LandmarkTree(self.kind, threshold=self.threshold)
+        twin = LandmarkTree(self.kind, threshold=self.threshold, scale=self.scale)
         twin._parent, twin._leaves, twin._rows = list(self._parent), list(self._leaves), self._rows.copy()
         return twin
 
@@ -482,10 +522,10 @@ class LandmarkTree:
         }
 
     @classmethod
-    def from_arrays(cls, arrays: Mapping[str, np.ndarray], *, kind: str, threshold: float = DEFAULT_THRESHOLD
-                    ) -> LandmarkTree:
+    def from_arrays(cls, arrays: Mapping[str, np.ndarray], *, kind: str, threshold: float = DEFAULT_THRESHOLD,
+                    scale: float = DEFAULT_SCALE) -> LandmarkTree:
         """The map :meth:`to_arrays` describes; ``ValueError`` naming the first inconsistency."""
-        tree = cls(kind, threshold=threshold)
+        tree = cls(kind, threshold=threshold, scale=scale)
         checked = checked_arrays(arrays, kind)
         node = np.repeat(np.arange(len(checked.node_parent), dtype=np.int64), checked.node_size)
         tree._parent, tree._leaves = [int(p) for p in checked.node_parent], [int(v) for v in checked.viewframe_leaf]

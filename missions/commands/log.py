@@ -58,14 +58,12 @@ def run_info(args: argparse.Namespace) -> int:
     try:
         reader = open_log(args.log)
     except LogError as exc:
-        return _log_error(exc)
+        return _failed(exc)
     try:
         topics = open_topics(reader, args.topics)
         summary = describe(reader, topics)
-    except InputError as exc:
-        return print_input_error(exc)
-    except LogError as exc:
-        return _log_error(exc)
+    except (InputError, LogError) as exc:
+        return _failed(exc)
     finally:
         reader.close()
     if args.json:
@@ -82,17 +80,13 @@ def run_check(args: argparse.Namespace) -> int:
     try:
         mission = load_from_args(args.mission, args)
         reader = open_log(args.log)
-    except InputError as exc:
-        return print_input_error(exc)
-    except LogError as exc:
-        return _log_error(exc)
+    except (InputError, LogError) as exc:
+        return _failed(exc)
     try:
         topics = open_topics(reader, args.topics)
         findings = check_log(args.log, topics, reader.contents(), mission_needs(mission))
-    except InputError as exc:
-        return print_input_error(exc)
-    except LogError as exc:
-        return _log_error(exc)
+    except (InputError, LogError) as exc:
+        return _failed(exc)
     finally:
         reader.close()
     for finding in findings:
@@ -167,6 +161,9 @@ def _rate(contents: LogContents, count: int) -> float | None:
     return round(value, 2) if value else None
 
 
-def _log_error(exc: LogError) -> int:
+def _failed(exc: InputError | LogError) -> int:
+    """A map or mission that does not load, or a log that does not read: its lines, exit 2."""
+    if isinstance(exc, InputError):
+        return print_input_error(exc)
     print(str(exc), file=sys.stderr)
     return EXIT_INVALID

@@ -23,6 +23,7 @@ from maps.roadmap import Roadmap
 from maps.store import InputError, output_problem
 from missions.commands.common import EXIT_INVALID, EXIT_OK, fail
 from missions.commands.map_roadmap import draw_roadmap, print_roadmap, roadmap_info
+from perception.similarity import angle_of_cost
 
 UNITS = {"": 1, "b": 1, "kb": 10**3, "mb": 10**6, "gb": 10**9, "kib": 2**10, "mib": 2**20, "gib": 2**30}
 MAX_BUDGET = 2**40  # 1 TiB: far above any map; a larger "budget" is a typo
@@ -106,6 +107,7 @@ def run_info(args: argparse.Namespace) -> int:
     if args.plot is not None:
         return fail("map", f"--plot draws a roadmap; {args.file} is an LT-map (bearings plot draws a run's viewframes)")
     summary = tree.summary()
+    change = math.degrees(angle_of_cost(summary.threshold, tree.scale))
     if args.json:
         print(json.dumps({"file": args.file, "landmark_kind": summary.kind, "viewframes": summary.viewframes,
                           "landmarks": summary.landmarks, "nodes": summary.nodes, "height": summary.height,
@@ -119,7 +121,7 @@ def run_info(args: argparse.Namespace) -> int:
         ("height", summary.height),
         ("bytes", f"{summary.memory_bytes} ({summary.memory_bytes / 1024:.1f} KiB)"),
         ("per level", " ".join(str(n) for n in summary.landmarks_per_level) + "  (root first)"),
-        ("threshold", f"{summary.threshold:g} rad^2 (eq. 1)"),
+        ("threshold", f"{summary.threshold:g} (eq. 1: a {change:.1f} deg bearing change)"),
     ]
     print(args.file)
     for name, value in rows:

@@ -1,4 +1,4 @@
-"""WatchInterestEdges and LookAround alone: hand-set map and pose, manual clock, commands read back."""
+"""WatchInterestEdges alone: hand-set map and pose, manual clock, commands read back."""
 
 from __future__ import annotations
 
@@ -10,11 +10,11 @@ from py_trees.common import Status
 
 from behaviours.control import Parallel
 from behaviours.exploration.follow_path import FollowPath
-from behaviours.exploration.gaze import LookAround, WatchInterestEdges
+from behaviours.exploration.gaze import WatchInterestEdges
 from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
-from drivers.interfaces import PanTiltState
-from maps.exploration.gaze import GazeParams, camera_lift, speed_limit, survey
+from drivers.interfaces import PanTiltLimits, PanTiltState
+from maps.exploration.gaze import camera_lift, speed_limit
 from maps.exploration.goal import Goal, Mode
 from maps.exploration.grid import Cell, ExplorationMap, GridFrame
 from maps.exploration.head import StereoHead
@@ -23,6 +23,8 @@ from perception.geometry import Pose2D
 
 HEAD = StereoHead()  # the defaults of the ports: the simulator's stereo pair on the PTU-D46
 PTU, LIMIT, GAZE = "/ptu/command", "/robot/speed_limit", "/map/gaze"
+STEP = math.radians(185.1428 / 3600)  # a PTU-D46's position
+D46 = PanTiltLimits((-3090 * STEP, 3090 * STEP), (-907 * STEP, 604 * STEP), STEP, STEP, 2902 * STEP, 57 * STEP)
 
 
 def edge_map(*edges: tuple[list[float], list[float], Interest]) -> ExplorationMap:
@@ -88,15 +90,40 @@ def test_alternates_sides_after_the_dwell_remembering_pa():
     assert harness.read(PTU).pan < 0 and (harness.read(GAZE).target, harness.read(GAZE).remembered) == (1, 0)
 
 
-def test_turns_back_ahead_when_the_point_leaves_the_view():
+def test_turns_back_by_eq4_when_the_point_leaves_the_view():
     harness = BehaviourHarness(watch(home_tilt=-35.0),
                                blackboard={"/map/exploration": edge_map(LEFT), "/robot/odometry": Pose2D()})
     harness.tick()
-    harness.write("/robot/odometry", Pose2D(3.0, 0.0, 0.0))  # the point is now behind, 132 degrees off
+    harness.write("/robot/odometry", Pose2D(3.0, 0.0, 0.0))  # the point is behind, 132 degrees off: out of the image
+    harness.tick()
+    cmd = harness.read(PTU)
+    # eq. 4: phi/2 - atan(robot_radius / keep_ahead) = 31.3633 - atan(0.26 / 1.0) = 31.3633 - 14.5742 deg, left
+    assert (math.degrees(cmd.pan), math.degrees(cmd.tilt)) == pytest.approx((16.7891, -35.0), abs=1e-3)
+    assert harness.read(GAZE).watched == frozenset({0})
+
+
+def test_turns_back_to_the_front_with_the_earlier_rule():
+    harness = BehaviourHarness(watch(home_tilt=-35.0, turn_back="front", leave="pan_limit"),
+                               blackboard={"/map/exploration": edge_map(LEFT), "/robot/odometry": Pose2D()})
+    harness.tick()
+    harness.write("/robot/odometry", Pose2D(2.1, 0.0, 0.0))  # 95 degrees off: past max_pan, still in the image
     harness.tick()
     cmd = harness.read(PTU)
     assert (cmd.pan, cmd.tilt) == pytest.approx((0.0, math.radians(-35.0)))
     assert harness.read(GAZE).watched == frozenset({0})
+
+
+def test_the_command_keeps_within_what_the_unit_reports():
+    """A PTU-D46 reports +-158.91 deg and 149 deg/s: unseen floor behind on the left is looked at from its
+    pan limit, rounded to its 185.1428 arc-second steps, at its top speed."""
+    unit = PanTiltState(0.0, 0.0, False, 0.0, D46)
+    blackboard = {"/robot/odometry": Pose2D(), "/robot/unseen": Pose2D(-2.0, 0.2), "/ptu/state": unit}
+    harness = BehaviourHarness(watch(unseen_ahead="{/robot/unseen}"), blackboard=blackboard)
+    harness.tick()
+    cmd = harness.read(PTU)
+    assert math.degrees(cmd.pan) == pytest.approx(3090 * 185.1428 / 3600)  # 158.91, not 174
+    assert cmd.speed == pytest.approx(D46.max_speed)
+    assert harness.behaviour.params.pan_rate == pytest.approx(D46.max_speed)  # what the speed limit plans with
 
 
 def test_fixed_mode_looks_ahead_whatever_the_edges():
@@ -152,38 +179,6 @@ def test_the_speed_limit_reaches_the_drive():
     assert 0.0 < harness.read("/robot/command").v <= limit < 0.8
 
 
-# --------------------------------------------------------------------------------------------
-# LookAround
-
-
-def test_look_around_steps_through_the_survey_then_succeeds():
-    look = LookAround(settle=0.4)
-    harness = BehaviourHarness(look)
-    expected = survey(GazeParams())
-    seen = []
-    for _ in range(500):
-        status = harness.tick()
-        cmd = harness.read(PTU)
-        if not seen or seen[-1] != (cmd.pan, cmd.tilt):
-            seen.append((cmd.pan, cmd.tilt))
-        harness.write("/ptu/state", PanTiltState(cmd.pan, cmd.tilt, False))  # a unit that is there at once
-        harness.clock.advance(0.2)
-        if status == Status.SUCCESS:
-            break
-    assert status == Status.SUCCESS
-    assert np.allclose(np.array(seen), expected)
-    assert harness.behaviour.surveys == 1
-
-
-def test_look_around_holds_a_pose_until_the_unit_is_there():
-    harness = BehaviourHarness(LookAround(settle=0.0), blackboard={"/ptu/state": PanTiltState(0.0, 0.0, True)})
-    first = harness.read(PTU)
-    for _ in range(5):
-        assert harness.tick() == Status.RUNNING
-        harness.clock.advance(0.2)
-    assert first is None and harness.behaviour.index == 0
-
-
 def test_the_gaze_report_keeps_its_shape():
     harness = BehaviourHarness(watch(), blackboard={"/map/exploration": edge_map(LEFT), "/robot/odometry": Pose2D()})
     harness.tick()
@@ -208,15 +203,3 @@ def test_where_the_cameras_look_is_drawn_every_tick():
     harness.write("/robot/odometry", Pose2D(3.0, 0.0, 0.0))
     harness.tick()
     assert next(d for d in node.drawings() if d.entity.endswith("watched")).positions.shape == (0, 2)
-
-
-def test_each_look_around_node_counts_its_surveys_under_its_name():
-    look = LookAround(name="look around again", settle=0.0)
-    harness = BehaviourHarness(look)
-    for _ in range(200):
-        cmd = harness.read(PTU)
-        if cmd is not None:
-            harness.write("/ptu/state", PanTiltState(cmd.pan, cmd.tilt, False))
-        if harness.tick() == Status.SUCCESS:
-            break
-    assert report_sections(look) == {"exploration": {"look_arounds_look_around_again": 1}}

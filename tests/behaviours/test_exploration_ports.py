@@ -5,8 +5,9 @@ from __future__ import annotations
 import pytest
 
 from behaviours.exploration.follow_path import FollowPath
-from behaviours.exploration.gaze import LookAround, WatchInterestEdges
+from behaviours.exploration.gaze import WatchInterestEdges
 from behaviours.exploration.localise import LocalisePose
+from behaviours.exploration.look_around import LookAround
 from behaviours.exploration.map_stereo import MapStereo
 from behaviours.exploration.ports import CAMERA_POSITION, FRAMES, MAP, POSE, PTU_POSITION, ROBOT_RADIUS, xyz
 from behaviours.exploration.select_goal import SelectGoalPoint
@@ -35,7 +36,7 @@ def test_the_exploration_node_types_are_builtins_from_the_sub_package():
     assert modules == {
         "LocalisePose": "behaviours.exploration.localise", "MapStereo": "behaviours.exploration.map_stereo",
         "SelectGoalPoint": "behaviours.exploration.select_goal", "FollowPath": "behaviours.exploration.follow_path",
-        "WatchInterestEdges": "behaviours.exploration.gaze", "LookAround": "behaviours.exploration.gaze",
+        "WatchInterestEdges": "behaviours.exploration.gaze", "LookAround": "behaviours.exploration.look_around",
     }
 
 

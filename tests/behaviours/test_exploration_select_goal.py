@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from py_trees.common import Status
@@ -70,6 +72,30 @@ def test_the_closest_frontier_strategy_never_follows_points():
     harness.tick()
     goal = harness.read(GOAL)
     assert goal.mode is Mode.FRONTIER and goal.point is None
+
+
+def test_the_strategies_set_the_goal_parameters():
+    assert select().params.nearby == 1.0 and not select().params.closest_frontier  # nearby_attraction
+    assert select(nearby=2.5).params.nearby == 2.5
+    assert select(strategy="attraction", nearby=2.5).params.nearby == math.inf  # eq. 1 over all points
+    assert select(strategy="closest_frontier").params.closest_frontier
+
+
+def test_nearby_attraction_prefers_the_near_border_eq1_over_all_points_the_far_one():
+    """Two gaps: one next to the robot with a point 1.5 m beyond, one across the room with a point 4 m
+    beyond. Eq. 1 over all points goes across (4 - 0.25 G beats 1.5 - 0.25 G'); nearby_attraction
+    stays near: the far gap's border costs more than nearby (1 m) beyond the closest border."""
+    m = explored_room([[-1.5, 1.0, 0.5], [7.0, 1.0, 0.5]])
+    cells = m.cells.copy()
+    cells[16:24, 9] = Cell.FREE  # a gap in the west wall too (y 0.6 - 1.4)
+    m = ExplorationMap.from_cells(m.frame, cells, points=m.points)
+    blackboard = {MAP: m, POSE: Pose2D(0.5, 1.0)}
+    harness = BehaviourHarness(select(strategy="attraction"), blackboard=blackboard)
+    harness.tick()
+    assert harness.read(GOAL).point == 1 and harness.read(GOAL).target[0] > 2.5
+    harness = BehaviourHarness(select(), blackboard=blackboard)
+    harness.tick()
+    assert harness.read(GOAL).point == 0 and harness.read(GOAL).target[0] < 0.5
 
 
 def test_reaching_the_goal_spends_its_point_and_chooses_again():

@@ -139,19 +139,28 @@ def test_flip_rule_is_blocked_for_a_half_turn_after_a_switch():
 
 
 def test_a_flip_far_from_the_viewframe_is_noise():
-    harness = switch_harness(RouteProgress(1, 2, 5, 0.0), turn_rate=90.0)
-    for t, heading in ((5.0, 0.1), (5.5, 3.0)):
-        harness.clock.set(t)
-        harness.write("/map/route_estimate", estimate(2, t, TREE.threshold * 10, heading))
-        harness.tick()
-    assert harness.read("/map/route_progress").target == 2
+    # near: under the eq. 1 cost of flip_near = 2.7 times the threshold's 3 deg, 8.1 deg: x = 1 - cos(8.1 deg) =
+    # 9.976342e-3, x / b = 16.376863, sqrt(1 + 268.201633) - 1 = 15.407365, times 2 b^2 = 7.421836e-7:
+    # 1.143509e-5, 10.54 thresholds of 1.085038e-6
+    for delta, switched in ((20.0, False), (10.0, True)):
+        harness = switch_harness(RouteProgress(1, 2, 5, 0.0), turn_rate=90.0)
+        for t, heading in ((5.0, 0.1), (5.5, 3.0)):
+            harness.clock.set(t)
+            harness.write("/map/route_estimate", estimate(2, t, TREE.threshold * delta, heading))
+            harness.tick()
+        assert harness.read("/map/route_progress").target == (3 if switched else 2)
 
 
 def test_the_goal_needs_a_tighter_delta_t_and_ends_the_route():
+    # the goal: under the eq. 1 cost of goal_fraction = 0.34 of the threshold's 3 deg, 1.02 deg:
+    # x = 1 - cos(1.02 deg) = 1.584578e-4, x / b = 0.260120, sqrt(1 + 0.067662) - 1 = 0.033277,
+    # times 2 b^2 = 7.421836e-7: 2.469793e-8, 0.0228 of the threshold (1.085038e-6)
     harness = switch_harness(RouteProgress(-1, 0, 5, 0.0))  # reverse: viewframe 0 is the last
     harness.write("/map/route_estimate", estimate(0, 1.0, TREE.threshold * 0.5))
-    assert harness.tick() == Status.RUNNING  # under the threshold, not under a quarter of it
-    harness.write("/map/route_estimate", estimate(0, 1.1, TREE.threshold * 0.2))
+    assert harness.tick() == Status.RUNNING  # under the threshold, not under the goal's
+    harness.write("/map/route_estimate", estimate(0, 1.1, TREE.threshold * 0.03))
+    assert harness.tick() == Status.RUNNING
+    harness.write("/map/route_estimate", estimate(0, 1.2, TREE.threshold * 0.02))
     assert harness.tick() == Status.SUCCESS and harness.read("/map/route_progress").finished
 
 
@@ -192,7 +201,32 @@ def test_follow_route_draws_its_estimate_while_it_follows():
     assert np.allclose(arrow.vectors, [[math.cos(estimate.error), math.sin(estimate.error)]])
     matched = drawn["route/robot_frame/matched_landmarks"]
     assert isinstance(matched, Points) and len(matched.positions) == estimate.matched and matched.radius == 0.02
-    assert report_sections(node) == {}  # following adds nothing to the report
+
+
+def counted(**counts: int) -> dict:
+    rules = ("zinf_1deg", "zinf_2deg", "zinf_4deg", "zinf_8deg", "compass", "no_rotation", "lost")
+    return {"ltmap": {"estimates": {rule: counts.get(rule, 0) for rule in rules}}}
+
+
+def test_follow_route_counts_every_estimate_by_the_rule_that_made_it():
+    target = len(PLACES) // 2
+    harness = follow_harness(Pose2D(), target, k=1)
+    IdealBase(harness, Pose2D(PLACES[target].x - 0.4, 0.0, 0.0))
+    node = harness.behaviour
+    assert report_sections(node) == counted()  # every rule, counted from zero
+    harness.tick()  # the corridor's far landmarks stay within 1 deg: the paper's rung
+    assert harness.read("/map/route_estimate").rule == "zinf_1deg"
+    nothing = Observation(np.zeros((0, 3)), 9.0, "bearings", ids=np.zeros(0, dtype=np.int64))
+    harness.write("/perception/observation", nothing)
+    harness.tick()
+    assert harness.read("/map/route_estimate").rule == "" and report_sections(node) == counted(zinf_1deg=1, lost=1)
+    node.initialise()  # a recovery runs the node again: the counts go on
+    assert report_sections(node) == counted(zinf_1deg=1, lost=1)
+    compass = follow_harness(Pose2D(), target, k=1, rotation="compass")
+    IdealBase(compass, Pose2D(PLACES[target].x - 0.4, 0.0, 0.0))
+    compass.tick()
+    assert compass.read("/map/route_estimate").status == "ok"  # asked for, not a fallback
+    assert report_sections(compass.behaviour) == counted(compass=1)
 
 
 def test_switch_draws_each_switch_once():

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import py_trees
 import pytest
@@ -11,6 +13,7 @@ from behaviours.teach import LearnRoute
 from behaviours.telemetry import Points, report_sections
 from behaviours.testing import BehaviourHarness
 from maps.ltmap.file import load_ltmap
+from perception.geometry import Pose2D
 from perception.synthetic_route import observe_route, straight_route
 from tests.behaviours.routes import WORLD
 
@@ -51,10 +54,30 @@ def test_learn_route_saves_the_map_when_the_drive_succeeds(tmp_path):
     section = report_sections(node)["ltmap"]
     assert section["saved"] and section["viewframes"] == saved.viewframe_count
     assert list(section) == ["landmark_kind", "viewframes", "landmarks", "nodes", "height", "bytes",
-                             "landmarks_per_level", "threshold", "map_file", "saved", "online_prunes", "taught"]
+                             "landmarks_per_level", "threshold", "map_file", "saved", "online_prunes", "taught",
+                             "gap_filling", "shifted", "loops", "loop_closures"]
     assert section["map_file"] == str(path) and section["online_prunes"] == 0
+    assert section["gap_filling"] is True and section["loops"] == [] and section["loop_closures"] == 0
     times = [entry["time_s"] for entry in section["taught"]]
     assert len(times) == saved.viewframe_count and times == sorted(times) and times[-1] == pytest.approx(6.0)
+
+
+def test_learn_route_counts_the_landmarks_shifted_and_the_loops_closed():
+    out = straight_route(2.0, 0.05)
+    back = [Pose2D(2.0 - p.x, 0.0, math.pi, stamp=out[-1].stamp + 0.1 + p.stamp) for p in out[1:]]
+    for gap_filling in (True, False):
+        node = LearnRoute(name="learn", child=Scripted(len(out) + len(back)), gap_filling=gap_filling)
+        teach(BehaviourHarness(node), out + back)
+        section = report_sections(node)["ltmap"]
+        loops = section["loops"]
+        assert section["gap_filling"] is gap_filling
+        if gap_filling:  # back along the way out: loops, each an earlier viewframe and a later one, one closure
+            assert loops and all(a < b and shared >= 8 for (a, b), shared in
+                                 ((loop["viewframes"], loop["shared"]) for loop in loops))
+            later = [loop["viewframes"][1] for loop in loops]
+            assert section["loop_closures"] == 1 + sum(b - a > 1 for a, b in zip(later, later[1:], strict=False))
+        else:
+            assert loops == [] and section["shifted"] == 0
 
 
 def test_learn_route_saves_nothing_when_the_drive_fails(tmp_path):

@@ -15,7 +15,7 @@ import pytest
 from drivers.cameras import CameraError, HttpCameraSettings, OpenCVCameraSettings, open_http_camera, open_opencv_camera
 from drivers.interfaces import Camera
 from maps.store import InputError, write_yaml
-from perception.camera import CatadioptricCamera, PanoramaCamera, PinholeCamera
+from perception.camera import CatadioptricCamera, PanoramaCamera, PinholeCamera, StereoRig
 
 
 def _write_video(path: Path, frames: int, size: tuple[int, int] = (64, 48), fps: float = 20.0) -> Path:
@@ -103,6 +103,20 @@ def test_calibration_gives_the_model_and_checks_the_size(tmp_path, video, device
         open_opencv_camera(device=str(video), calibration=str(broken))
     with pytest.raises(InputError, match="no such file"):
         open_opencv_camera(device=str(video), calibration=str(tmp_path / "none.yaml"))
+
+
+def test_a_stereo_pair_side_by_side_is_split_into_left_and_right(tmp_path, devices):
+    eye = PinholeCamera(32, 48, 40.0, 40.0, 15.5, 23.5)
+    calibration = tmp_path / "stereo.yaml"
+    write_yaml(calibration, StereoRig(eye, eye, 0.12).to_dict())
+    both = _write_video(tmp_path / "pair.avi", frames=4, size=(64, 48))  # 32 px wide each, side by side
+    camera = devices(open_opencv_camera(device=str(both), calibration=str(calibration), fps=100.0))
+    frame = _wait_frame(camera)
+    assert isinstance(frame.camera, StereoRig) and frame.image.shape[:2] == (48, 32)
+    assert frame.right is not None and frame.right.shape[:2] == (48, 32)
+    single = _write_video(tmp_path / "one.avi", frames=2, size=(32, 48))
+    with pytest.raises(CameraError, match="32x48 but the camera model is 64x48 \\(a stereo pair side by side\\)"):
+        open_opencv_camera(device=str(single), calibration=str(calibration), timeout=1.0)
 
 
 def test_catadioptric_frames_are_unwarped_to_a_panorama(tmp_path, devices):

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import time
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -93,6 +94,19 @@ def test_initialisation_sequence(ptu):
     assert degrees["tilt"] == pytest.approx((-907 * 46.2857 / 3600, 604 * 46.2857 / 3600), abs=1e-3)
     assert "v2.14.0" in pan_tilt.version
     assert pan_tilt.state().pan == 0.0 and not pan_tilt.state().moving
+
+
+def test_the_state_carries_what_the_unit_reports_within_the_soft_limits(ptu):
+    pan_tilt, _ = ptu(settings={"pan_max_deg": 120.0})
+    limits = pan_tilt.state().limits
+    assert np.degrees(limits.pan).tolist() == pytest.approx([-3090 * RES / 3600, 120.0])  # -158.91: the unit's
+    assert np.degrees(limits.tilt).tolist() == pytest.approx([-907 * RES / 3600, 604 * RES / 3600])
+    assert math.degrees(limits.pan_step) == pytest.approx(RES / 3600)
+    assert math.degrees(limits.max_speed) == pytest.approx(2902 * RES / 3600)  # 149.2 deg/s
+    assert math.degrees(limits.min_speed) == pytest.approx(57 * RES / 3600)
+    pan, _ = limits.clip(math.radians(-159.0), 0.0)
+    pan_tilt.move(pan, 0.0, 1.0)  # the mission's -159 clipped into the unit: accepted
+    assert pan_tilt.state().homings == 0
 
 
 def test_moves_in_radians_with_speed_and_reads_back(ptu):

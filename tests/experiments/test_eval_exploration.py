@@ -10,7 +10,17 @@ import numpy as np
 import pytest
 
 from drivers.sim.world import load_world
-from experiments.eval.exploration import check_world, episode_figures, episodes, seen_floor, summarise_variant
+from experiments.eval.exploration import (
+    Settings,
+    check_options,
+    check_world,
+    episode_figures,
+    episodes,
+    pose_errors,
+    seen_floor,
+    summarise_variant,
+    variant_of,
+)
 from maps.exploration.codec import pack_cells
 from maps.exploration.head import StereoHead, footprint
 from missions.cli import main
@@ -81,10 +91,55 @@ def test_episode_figures_and_the_criterion():
     assert summary["episodes"] == 2 and summary["errors"] == 1 and summary["coverage_min"] == 0.0
 
 
-def test_three_variants_per_seed():
+def test_four_variants_per_seed():
     runs = episodes("lab", [0, 1])
-    assert len(runs) == 6 and {e.inputs["gaze"] for e in runs} == {"edges", "fixed"}
-    assert {e.inputs["strategy"] for e in runs} == {"attraction", "closest_frontier"}
+    assert len(runs) == 8 and {e.inputs["gaze"] for e in runs} == {"edges", "fixed"}
+    assert {e.inputs["strategy"] for e in runs} == {"nearby_attraction", "attraction", "closest_frontier"}
+    assert {variant_of(e.inputs) for e in runs} == {"method", "baseline", "fixed", "eq1"}
+    assert {e.inputs["localisation"] for e in runs} == {"stereo"}  # the visual localisation by default
+
+
+def test_the_localisation_option_names_the_oracle_beside_the_visual(tmp_path):
+    assert check_options("lab", {}) == Settings(0, localisations=("visual",))
+    both = check_options("lab", {"localisation": "visual,ideal", "people": "2"})
+    assert both == Settings(2, localisations=("visual", "ideal"))
+    with pytest.raises(ValueError, match="visual, ideal or visual,ideal"):
+        check_options("lab", {"localisation": "gps"})
+    stereo_only = tmp_path / "stereo_only.yaml"
+    stereo_only.write_text(Path(BOX).read_text() + "cameras:\n  - {name: stereo, kind: stereo, mount: ptu}\n")
+    assert check_options(str(stereo_only), {"localisation": "visual"}).localisations == ("visual",)
+    with pytest.raises(ValueError, match="localisation ideal needs the camera 'landmarks'"):
+        check_options(str(stereo_only), {"localisation": "visual,ideal"})
+    runs = episodes("lab", [0], variants=("method", "baseline", "fixed"), localisations=("visual", "ideal"))
+    assert len(runs) == 6 and sorted(variant_of(e.inputs) for e in runs) == [
+        "baseline", "baseline/ideal", "fixed", "fixed/ideal", "method", "method/ideal"]
+
+
+def test_the_pose_error_is_against_the_truth_in_the_start_frame():
+    # the robot starts at (1, 2) facing +y; the odometry frame's x axis is the world's +y
+    trajectory = [[0.0, 1.0, 2.0, math.pi / 2], [10.0, 1.0, 4.0, math.pi / 2]]
+    located = {"final_pose": {"x": 2.05, "y": 0.0, "theta": math.radians(1.0), "t": 10.0},
+               "track": [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0], [5.0, 1.0, 0.03, 0.0, 0.01, 0.001]],
+               "position_sigma_m": 0.02}
+    errors = pose_errors(report([], trajectory, localisation=located))
+    # the final pose is (2.05, 0) in the start frame: world (1, 4.05), 5 cm beyond the truth, 1 degree off
+    assert errors["pose_error_m"] == pytest.approx(0.05) and errors["heading_error_deg"] == pytest.approx(1.0)
+    assert errors["pose_error_max_m"] == pytest.approx(0.05) and errors["pose_ok"]
+    assert errors["pose_error_at_60s_m"] == pytest.approx(0.03)  # the last row by then: (1, 0.03) at 5 s
+    assert pose_errors(report([], trajectory)) == {}
+
+
+def test_the_variants_option_names_the_runs_and_the_method_always_runs():
+    settings = check_options("lab", {"variants": "gaze_before, closest_edges"})
+    assert settings.variants == ("method", "gaze_before", "closest_edges") and settings.people == 0
+    runs = episodes("lab", [0], variants=settings.variants)
+    # the method and gaze_before differ only in the two gaze rules; each run maps back to its own variant
+    assert [variant_of(e.inputs) for e in runs] == ["method", "gaze_before", "closest_edges"]
+    assert runs[1].inputs == {**runs[0].inputs, "leave": "pan_limit", "turn_back": "front"}
+    assert all(e.inputs["localisation"] == "stereo" for e in runs)
+    assert check_options("lab", {}).variants == ("method", "baseline", "fixed", "eq1")
+    with pytest.raises(ValueError, match="nearest"):
+        check_options("lab", {"variants": "method,nearest"})
 
 
 def test_the_command_refuses_an_open_world_and_bad_numbers(capsys):
@@ -99,11 +154,11 @@ def test_the_command_runs_the_episodes_through_the_sweep_runner(tmp_path, capsys
                  "-o", str(tmp_path / "out"), "--json"])
     assert code == 0
     figures = json.loads(capsys.readouterr().out)
-    assert figures["area"] == "exploration" and figures["world"] == "box" and figures["episodes"] == 3
-    for variant in ("method", "baseline", "fixed"):
+    assert figures["area"] == "exploration" and figures["world"] == "box" and figures["episodes"] == 4
+    for variant in ("method", "baseline", "fixed", "eq1"):
         assert figures[f"{variant}.episodes"] == 1 and figures[f"{variant}.done"] == 0  # 2 s: not done
         assert 0.0 < figures[f"{variant}.coverage"] < 1.0
-    assert len(figures["runs"]) == 3 and (tmp_path / "out" / "results.jsonl").exists()
+    assert len(figures["runs"]) == 4 and (tmp_path / "out" / "results.jsonl").exists()
 
 
 def test_episodes_that_all_fail_are_counted_not_a_crash(tmp_path, capsys):
@@ -111,6 +166,6 @@ def test_episodes_that_all_fail_are_counted_not_a_crash(tmp_path, capsys):
                  "-o", str(tmp_path / "out"), "--json"])
     assert code == 0
     figures = json.loads(capsys.readouterr().out)
-    for variant in ("method", "baseline", "fixed"):
+    for variant in ("method", "baseline", "fixed", "eq1"):
         assert figures[f"{variant}.errors"] == 1 and figures[f"{variant}.ok"] == 0
     assert figures["method_vs_baseline.path_length_ratio"] is None

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from drivers.sim.simulation import start_to_world
+from drivers.sim.simulation import path_distances, start_to_world
 from drivers.sim.world import load_world
 from experiments.eval import AREAS
 from experiments.eval.ltmap import (
@@ -22,6 +22,7 @@ from experiments.eval.ltmap import (
     format_table,
     goal_tolerance,
     repeat_figures,
+    teach_episode,
     viewframe_errors,
 )
 from experiments.eval.ltmap_route import MARGINS, MIN_END, Floor, default_route, parse_route
@@ -88,12 +89,37 @@ def test_options_are_checked_against_the_world(world_file):
                            ({"route": "1.521,0.085,3.024,-0.462"}, "leg to waypoint 1 passes"),  # across the pillar
                            ({"min_landmarks": "-1"}, ">= 0"),
                            ({"goal_tolerance": "nan"}, "positive"),
-                           ({"rotation": "gyro"}, "zinf, compass")]:
+                           ({"rotation": "gyro"}, "zinf, compass"),
+                           ({"gap_filling": "yes"}, "on or off"),
+                           ({"route": "loop"}, "numbers x0,y0")]:
         with pytest.raises(ValueError, match=message):
             check_options(path, extra)
     assert parse_route("1, 2,3,4") == [1.0, 2.0, 3.0, 4.0]
     assert check_options(path, {"camera": "landmarks"}).rotation == "zinf"
     assert check_options(path, {"camera": "landmarks", "rotation": "compass"}).rotation == "compass"
+
+
+def test_the_route_back_retraces_the_tour_and_ends_a_third_of_the_way_out(world_file):
+    world = load_world(world_file(ROOM))
+    tour, back = default_route(world), check_options(str(world_file(ROOM)), {"route": "back"}).route
+    assert back.source == "back" and back.margin_m == tour.margin_m
+    assert np.array_equal(back.world_xy[:len(tour.world_xy)], tour.world_xy)  # out along the tour
+    returned = back.world_xy[len(tour.world_xy) - 1:]  # and back along its legs, reversed
+    along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(returned, axis=0).T))))
+    assert along[-1] == pytest.approx(2.0 / 3.0 * tour.length_m) and back.length_m == pytest.approx(
+        5.0 / 3.0 * tour.length_m)
+    assert np.all(path_distances(returned, tour.world_xy) < 1e-9)  # every point of the way back on the tour
+    np.testing.assert_allclose(start_to_world(world.start, np.reshape(back.odometry, (-1, 2))), back.world_xy[1:],
+                               atol=1e-9)
+
+
+def test_gap_filling_off_is_an_input_of_the_teach_and_the_default_keeps_the_ids(world_file, tmp_path):
+    path = str(world_file(ROOM))
+    on, off = (check_options(path, {"camera": "landmarks", "gap_filling": v}) for v in ("on", "off"))
+    assert on.gap_filling and not off.gap_filling
+    taught_on, taught_off = (teach_episode(path, 0, s, tmp_path, None) for s in (on, off))
+    assert "gap_filling" not in taught_on.inputs and taught_off.inputs["gap_filling"] is False
+    assert taught_on.inputs["map"] != taught_off.inputs["map"]  # one results folder can hold both
 
 
 def test_the_compass_repeat_carries_its_rotation_and_the_default_keeps_the_ids():
@@ -129,6 +155,12 @@ def test_viewframes_are_matched_through_times_and_sources():
     assert figures["reached"] and figures["viewframes_reached"] == 1.0
     assert not repeat_figures(taught, repeat, level, tolerance=0.05)["reached"]
     assert not repeat_figures(taught, {**repeat, "status": "FAILURE"}, level, tolerance=0.5)["reached"]
+    assert figures["bytes_per_m"] == pytest.approx(900 / 3.0)  # taught along 3 m
+    assert figures["estimates_pct"] is None  # a report without the counts
+    counted = repeat_figures(taught, {**repeat, "ltmap": {**repeat["ltmap"], "estimates": {
+        "zinf_1deg": 6, "zinf_4deg": 2, "compass": 1, "lost": 1}}}, level, tolerance=0.5)
+    assert counted["estimates_pct"] == {"zinf_1deg": 60.0, "zinf_2deg": 0.0, "zinf_4deg": 20.0, "zinf_8deg": 0.0,
+                                        "compass": 10.0, "no_rotation": 0.0, "lost": 10.0}
     touched = {**repeat, "ground_truth": {**repeat["ground_truth"], "collisions": 1, "min_clearance_m": 0.0},
                "safety": {"safety_stops": 2}}  # home, but it touched something on the way: not reached
     collided = repeat_figures(taught, touched, level, tolerance=0.5)
@@ -155,6 +187,10 @@ def test_the_evaluation_on_a_small_world_file(world_file, tmp_path, capsys):
     assert figures["full.goal_reached"] == 1 and figures["full.path_error_m"] < 0.2  # the full tree leads home
     assert figures["full.collisions"] == 0 and figures["teach.collisions"] == 0
     assert figures["full.viewframe_error_m"] < 0.6
+    shares = rows[0]["estimates_pct"]  # every estimate of the full tree's repeat counted by its rule
+    assert shares.keys() == {"zinf_1deg", "zinf_2deg", "zinf_4deg", "zinf_8deg", "compass", "no_rotation", "lost"}
+    assert sum(shares.values()) == pytest.approx(100.0)
+    assert rows[0]["bytes_per_m"] == pytest.approx(rows[0]["bytes"] / figures["teach.path_length_m"])
     assert all(r["map_as_expected"] for r in figures["runs"]) and "warning" not in figures
     assert len((out / "results.jsonl").read_text().splitlines()) == 1 + len(rows)  # a teach, a repeat per height
     assert list((out / "maps").iterdir())
@@ -165,7 +201,7 @@ def test_the_evaluation_on_a_small_world_file(world_file, tmp_path, capsys):
     teaching = next(line for line in table.splitlines() if line.startswith("teaching: "))
     clearance = float(teaching.split("clear ")[1])  # the closest the robot's disc came to anything
     assert teaching.startswith("teaching: 0 coll, 0 stops, clear ") and 0.05 < clearance < 1.0
-    assert len(table.splitlines()) == 5 + len(rows)
+    assert len(table.splitlines()) == 7 + len(rows)
     assert len((out / "results.jsonl").read_text().splitlines()) == 1 + len(rows)
     assert format_table(figures) == table.rstrip("\n")
 

@@ -178,7 +178,7 @@ def test_exploration_with_people_runs_every_variant_in_the_seeds_world(tmp_path,
                  "--option", "people=2", "-o", str(tmp_path / "out"), "--json"])
     assert code == 0, capsys.readouterr().err
     figures = json.loads(capsys.readouterr().out)
-    assert figures["people"] == 2 and figures["people.placed"] == {"0": 2} and figures["episodes"] == 3
+    assert figures["people"] == 2 and figures["people.placed"] == {"0": 2} and figures["episodes"] == 4
     rows = [json.loads(line) for line in (tmp_path / "out" / "results.jsonl").read_text().splitlines()]
     assert {row["world"] for row in rows} == {str(tmp_path / "out" / "people" / "s0000" / "box.yaml")}
     assert len(load_world(rows[0]["world"]).people) == 2

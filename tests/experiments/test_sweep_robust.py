@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 
+from experiments.sweep import worker
 from missions.cli import main
 
 TRAP_PLUGIN = """
@@ -197,3 +198,23 @@ def test_ctrl_c_keeps_finished_rows_kills_running_episodes_and_resume_runs_the_r
     rows = rows_of(out)
     assert [r["inputs.action"] for r in rows] == ["hang", "none"] and rows[1] == first
     assert rows[0]["reason"] == "timed out after 0.5 s wall time (episode killed)"  # run again, its row replaced
+
+
+class _SlowToKill:
+    """A warm server that loses touch while killing its episode (a loaded machine)."""
+
+    def run(self, *args: object) -> tuple[int | None, str | None]:
+        raise worker._ServerLost("the killed episode did not end")
+
+
+def test_a_server_lost_while_stopping_does_not_start_the_episode_again(tmp_path, monkeypatch):
+    stop = worker.StopToken(str(tmp_path / "stop"))
+    stop.set()  # Ctrl-C came first: the server was told to kill the episode and did not answer in time
+    started_again = []
+    monkeypatch.setattr(worker._Server, "drop", classmethod(lambda cls: None))
+    monkeypatch.setattr(worker._Server, "get", classmethod(lambda cls: started_again.append(1)))
+    outcome = worker._run_forked(_SlowToKill(), ["run", "x"], tmp_path / "log", time.monotonic(), 60.0, stop)
+    assert outcome == (None, "interrupted") and not started_again
+    stop.clear()  # not stopped, time left: the episode gets one more server, as before
+    worker._run_forked(_SlowToKill(), ["run", "x"], tmp_path / "log", time.monotonic(), 60.0, stop)
+    assert started_again == [1]

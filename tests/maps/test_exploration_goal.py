@@ -68,6 +68,22 @@ def test_the_highest_attractive_power_wins_and_eta_trades_distance_for_travel():
     assert goal is not None and goal.point == 1 and goal.target == pytest.approx((0.25, 0.95))
 
 
+def test_nearby_lets_only_points_of_borders_about_as_close_as_the_closest_compete():
+    m = explored_strip([P1, P2])  # the closest border: (0.05, 0.55), G = 2 cells = 0.2
+    # nearby 1: P1's border costs 1.7 > 0.2 + 1.0, out (power -inf); P2's 0.4 <= 1.2 competes and wins,
+    # although eq. 1 over both prefers P1 (1.625 > 1.45)
+    near = GoalParams(eta=0.25, k=1.0, robot_radius=0.0, min_frontier=0.1, nearby=1.0)
+    found = candidates(m, ROBOT, near)
+    assert found.power == pytest.approx([-math.inf, 1.55 - 0.25 * 0.4])
+    switch, goal = select_goal(ModeSwitch(), m, ROBOT, near)
+    assert switch.mode is Mode.ATTRACTION and goal is not None and goal.point == 1
+    # nearby 0.1: 0.4 > 0.2 + 0.1, no point attracts: frontier mode, the closest border
+    switch, goal = select_goal(ModeSwitch(), m, ROBOT, GoalParams(0.25, 1.0, 0.0, 0.1, nearby=0.1))
+    assert switch.mode is Mode.FRONTIER and goal is not None and goal.cost == pytest.approx(0.2)
+    with pytest.raises(ValueError, match="nearby"):
+        GoalParams(nearby=-1.0)
+
+
 def test_points_inside_the_explored_area_do_not_attract():
     switch, goal = select_goal(ModeSwitch(), explored_strip([[1.0, 0.5, 0.3], [1.5, 1.5, 0.3]]), ROBOT, NO_RADIUS)
     # the first is on explored floor (d = 0), the second 0.55 m beyond the border (< K)

@@ -30,7 +30,7 @@ def test_a_saved_map_loads_identical(tmp_path, kind):
     assert original.keys() == again.keys()
     for name, array in original.items():
         assert np.array_equal(again[name], array) and again[name].dtype == array.dtype
-    assert (loaded.kind, loaded.threshold) == (tree.kind, tree.threshold)
+    assert (loaded.kind, loaded.threshold, loaded.scale) == (tree.kind, tree.threshold, tree.scale)
     assert loaded.summary() == tree.summary()
     for i in range(tree.viewframe_count):  # the same viewframes, landmark for landmark
         a, b = tree.viewframe(i), loaded.viewframe(i)
@@ -59,7 +59,18 @@ def test_every_bad_file_is_one_clear_line():
     assert "checksum" in one_line_error(bytes(flipped))
     assert "not a bearings map" in one_line_error(b"\x89PNG\r\n\x1a\n")
     assert "roadmap map file, not a ltmap" in one_line_error(encode_map(kind="roadmap", version=1, arrays={}))
-    assert "version 2" in one_line_error(encode_map(kind=KIND, version=2, arrays={}))
+    assert "version 3" in one_line_error(encode_map(kind=KIND, version=3, arrays={}))
+
+
+def test_a_version_1_map_is_read_with_the_eq1_threshold_of_the_same_bearing_change():
+    tree = taught("ids", 1.0)
+    # version 1 held the angle form's 1e-3 rad^2: 3.04300 deg (tests/perception/test_similarity.py);
+    # eq. 1 at 3.043 deg: x = 1 - cos(3.043 deg) = 1.410024e-3, x / b = 2.314653, sqrt(1 + 5.357619) - 1 = 1.521432,
+    # times 2 b^2 = 7.421836e-7: 1.129182e-6
+    old = encode_map(kind=KIND, version=1, arrays=tree.to_arrays(), meta={"landmarks": "ids", "threshold": 1e-3})
+    loaded = decode_ltmap(old, file="old.ltmap")
+    assert loaded.threshold == pytest.approx(1.129182e-6, rel=1e-4)
+    assert loaded.scale == tree.scale and loaded.viewframe_count == tree.viewframe_count
 
 
 def test_a_sound_container_with_an_inconsistent_tree_is_refused():

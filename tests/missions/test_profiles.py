@@ -87,6 +87,25 @@ def test_driver_settings_are_checked_against_the_opener_declaration(tmp_path, mo
     assert opened == [ToySettings(port="/dev/null")] and robot.name == "robot"
 
 
+def test_explore_validates_against_a_robot_with_a_stereo_pair_on_its_pan_tilt_unit(capsys):
+    stereo = PROFILES / "p3dx-ptu-stereo.yaml"
+    assert main(["validate", "explore", "--robot", str(stereo)]) == 0
+    assert "ok (explore" in capsys.readouterr().out
+    # the oracle needs the simulator's landmarks camera, which no robot has
+    assert main(["validate", "explore", "--robot", str(stereo), "--set", "localisation=landmarks"]) == 2
+    assert "uses camera(s) landmarks, which robot 'p3dx-ptu-stereo'" in capsys.readouterr().err
+    assert main(["validate", "explore", "--robot", str(PROFILES / "p3dx-omni.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert "uses camera(s) stereo" in err and "reads or drives the pan-tilt unit" in err
+
+
+def test_validate_against_an_invalid_profile_reports_the_profile(tmp_path, capsys):
+    path = tmp_path / "robot.yaml"
+    path.write_text("base: {driver: roomba}\n")
+    assert main(["validate", "square", "--robot", str(path)]) == 2
+    assert "unknown base driver 'roomba'" in capsys.readouterr().err
+
+
 def test_the_safety_section_is_checked_with_located_errors(tmp_path):
     path = tmp_path / "robot.yaml"
     path.write_text("base: {driver: pioneer, port: /dev/ttyUSB0}\nsafety:\n  stop_margin: -1\n"

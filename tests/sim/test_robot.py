@@ -76,6 +76,10 @@ def test_ptu_clips_targets_to_the_ptu_d46_limits(sim_from) -> None:
     drive(sim, 0.0, 0.0, 3.0)
     assert math.degrees(ptu.state().pan) == pytest.approx(-159.0)
     assert math.degrees(ptu.state().tilt) == pytest.approx(31.0)
+    limits = ptu.state().limits  # what it reports, for the head behaviours to keep within
+    assert np.degrees(limits.pan).tolist() == pytest.approx([-159.0, 159.0])
+    assert np.degrees(limits.tilt).tolist() == pytest.approx([-47.0, 31.0])
+    assert math.degrees(limits.max_speed) == pytest.approx(300.0) and limits.pan_step == 0.0
 
 
 def test_ptu_slews_at_the_requested_speed_capped_at_its_top_rate(sim_from) -> None:
