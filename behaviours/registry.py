@@ -38,9 +38,10 @@ KINDS: tuple[Kind, ...] = ("action", "condition", "decorator", "composite")
 ENTRY_POINT_GROUP = "bearings.behaviours"
 BUILTIN_MODULES = (
     "behaviours.control", "behaviours.composites", "behaviours.decorators", "behaviours.motion", "behaviours.wait",
-    "behaviours.conditions", "behaviours.perceive",
+    "behaviours.conditions", "behaviours.perceive", "behaviours.avoidance",
     # teach and repeat (the LT-map)
-    "behaviours.landmark_tree", "behaviours.teach", "behaviours.route", "behaviours.search", "behaviours.teleop",
+    "behaviours.landmark_tree", "behaviours.teach", "behaviours.route", "behaviours.route_skip", "behaviours.search",
+    "behaviours.teleop",
     "behaviours.waypoints", "behaviours.choice",
     # the roadmap between target images
     *(f"behaviours.roadmap.{m}" for m in ("targets", "calibration", "room", "coverage", "travel", "scan", "homing",

@@ -11,7 +11,7 @@ import py_trees
 from py_trees.common import ParallelPolicy
 
 from behaviours.registry import Registry
-from behaviours.sense import GrabFrames, ReadOdometry, ReadPanTilt
+from behaviours.sense import GrabFrames, ReadOdometry, ReadPanTilt, ReadRanges
 from maps.store import OutputFolders
 from missions.language import MissionSpec, NodeSpec
 from missions.outputs import resolved_ports
@@ -32,8 +32,8 @@ def build_node(spec: NodeSpec, registry: Registry, folders: OutputFolders | None
 
 
 def build_sense(mission: MissionSpec) -> py_trees.behaviour.Behaviour:
-    """The data-gathering branch: odometry, pan-tilt, cameras, then the mission's ``sense:``."""
-    readings = [ReadOdometry(), ReadPanTilt(), GrabFrames(cameras=mission.cameras)]
+    """The data-gathering branch: odometry, range sensors, pan-tilt, cameras, then the mission's ``sense:``."""
+    readings = [ReadOdometry(), ReadRanges(), ReadPanTilt(), GrabFrames(cameras=mission.cameras)]
     nodes = [*readings, *(build_node(s, mission.registry, mission.folders) for s in mission.sense)]
     return py_trees.composites.Sequence(name=SENSE_NAME, memory=False, children=nodes)
 

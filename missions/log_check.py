@@ -61,11 +61,12 @@ def mission_needs(mission: MissionSpec) -> Needs:
     for spec in (node for root in (*mission.sense, mission.tree) for node in root.walk()):
         node_type = mission.registry.lookup(spec.type)
         keys = keys or spec.type == "KeyboardTeleop"
+        optional = getattr(node_type.cls, "RANGES_OPTIONAL", False) if node_type else False  # works without them
         for port in node_type.inputs if node_type else ():
             value = spec.inputs.get(port.name)
             if isinstance(value, Ref):
                 ptu = ptu or value.base == PTU_KEY
-                ranges = ranges or value.base == RANGES_KEY
+                ranges = ranges or (value.base == RANGES_KEY and not optional)
             elif port.name == "camera" and isinstance(value, str) and value and mission.cameras is None:
                 cameras.append(value)
     return Needs(tuple(dict.fromkeys(cameras)), ptu, ranges, keys)

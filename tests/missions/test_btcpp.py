@@ -106,11 +106,19 @@ EVERY_NODE_TYPE = """
                 - StartRoute: {direction: reverse}
                 - RecoveryNode:
                     children:
-                      - Parallel:
-                          policy: one
+                      - RecoveryNode:
+                          number_of_retries: 4
                           children:
-                            - FollowRoute: {observation: "{/perception/panorama}"}
-                            - ViewframeSwitch
+                            - AvoidObstacles:
+                                wait: 1.5
+                                max_detour: 2.5
+                                child:
+                                  Parallel:
+                                    policy: one
+                                    children:
+                                      - FollowRoute: {observation: "{/perception/panorama}"}
+                                      - ViewframeSwitch
+                            - SkipViewframes: {window: 8, observation: "{/perception/panorama}"}
                       - SearchPattern: {observation: "{/perception/panorama}"}
           - Sequence:
               name: the roadmap nodes

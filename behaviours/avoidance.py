@@ -1,0 +1,210 @@
+"""Getting around what blocks the way: the ``AvoidObstacles`` decorator.
+
+Wrapped around a motion node in a mission (``AvoidObstacles: {child: FollowRoute: {...}}``), it
+lets the child steer as it always does and judges, after each tick of the child, the command the
+child wrote (``child_command``: ``/robot/command`` unless remapped) against the range sensors
+(``/robot/ranges``), the odometry and the collision monitor's verdict on the last command
+(``/robot/safety``). It writes the command that gets around (``command``):
+
+- the child's own, while its arc is free for as far as it means to go;
+- a stop while the way is blocked, for ``wait`` seconds, so a person walking across can pass;
+- then a detour: of a histogram of directions, the free one closest to where the child heads, on
+  one side of the obstacle, kept within ``max_stray`` of the line the robot was on (odometry),
+  until the child's own arc is free again; the child then steers back to its route or path by
+  itself;
+- FAILURE, with the reason as the node's message ("blocked for 20 s by an obstacle 0.40 m
+  ahead"), after ``timeout`` seconds held, or a detour of ``max_detour`` metres that did not get
+  past, so that the mission's recovery (a search pattern, a new goal) takes over.
+
+Otherwise its status is the child's. The algorithm is :mod:`maps.avoidance` (pure); the echoes of
+the last ``memory`` seconds are judged together (:mod:`maps.avoidance.memory`). Without range
+sensors (no ``/robot/ranges``) it sees nothing and passes every command on; the collision monitor
+still limits whatever reaches the base. ``enabled: false`` passes every command on, for runs that
+compare with and without it.
+
+Report section ``avoidance``, per node (its name): ``waits``, ``waits_cleared`` (the way cleared by
+itself), ``wait_time_s``, ``detours``, ``detour_length_m``, ``detour_time_s``, ``give_ups`` and
+their ``reasons``. Recording: ``avoidance/events``, ``avoidance/phase`` (0 clear, 1 waiting,
+2 detour), the histogram of directions judged (``avoidance/robot_frame/histogram``: a ray per
+direction as far as it is free up to 1 m, the chosen one green, those that would do grey, the
+others red) with the chosen direction (``avoidance/robot_frame/chosen``), and the detours driven
+(``odometry_frame/avoidance/detours``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import py_trees
+from py_trees.common import Status
+
+from behaviours.base import BearingsDecorator
+from behaviours.keys import RANGES_KEY, SAFETY_KEY
+from behaviours.motion import COMMAND, ODOMETRY
+from behaviours.ports import InputPort, Ref
+from behaviours.registry import register
+from behaviours.telemetry import Arrows, Drawing, Event, Figure, Lines, Plot
+from drivers.interfaces import STOP, VelocityCommand
+from maps.avoidance.detour import Avoidance, Decision, DetourSettings, Phase
+from maps.avoidance.directions import Choice
+from maps.avoidance.memory import ObstacleMemory
+from maps.avoidance.sweep import AvoidSettings
+from perception.collision_monitor import SafetyState
+from perception.geometry import Pose2D
+from perception.polygons import disc
+from perception.ranges import RangeScan
+
+PHASES: dict[Phase, float] = {"clear": 0.0, "waiting": 1.0, "detour": 2.0}
+DRAWN_REACH = 1.0  # m: arcs are drawn as far as they are free, up to this
+CHOSEN, FREE, BLOCKED = (0, 220, 0), (170, 170, 170), (230, 60, 40)
+REASONS_KEPT = 5  # give-up reasons in the report
+
+
+@register
+class AvoidObstacles(BearingsDecorator):
+    """Get the child's motion around what blocks its way: wait, detour, or give up (module docstring)."""
+
+    ENABLED = InputPort("enabled", bool, True, literal_only=True,
+                        doc="false: pass the child's command on unchanged (to compare runs with and without)")
+    SPEED = InputPort("speed", float, 0.2, unit="m/s", minimum=0.01, maximum=1.2, literal_only=True,
+                      doc="speed along a detour's arcs")
+    CLEARANCE = InputPort("clearance", float, 0.10, unit="m", minimum=0.0, maximum=1.0, literal_only=True,
+                          doc="kept between the footprint and every sensed point along an arc")
+    HORIZON = InputPort("horizon", float, 0.5, unit="s", minimum=0.0, maximum=10.0, literal_only=True,
+                        doc="an arc must be free for the braking distance plus this much travel")
+    TURN_RATE = InputPort("turn_rate", float, 45.0, unit="deg/s", minimum=1.0, maximum=300.0, literal_only=True,
+                          doc="turn rate on a detour")
+    WAIT = InputPort("wait", float, 2.0, unit="s", minimum=0.0, maximum=600.0, literal_only=True,
+                     doc="held this long before a detour is tried (a person walking across passes)")
+    TIMEOUT = InputPort("timeout", float, 20.0, unit="s", minimum=0.1, maximum=3600.0, literal_only=True,
+                        doc="held this long with no way around: FAILURE")
+    MAX_STRAY = InputPort("max_stray", float, 1.5, unit="m", minimum=0.1, maximum=100.0, literal_only=True,
+                          doc="a detour keeps within this of the line the robot was on when it was held")
+    MAX_DETOUR = InputPort("max_detour", float, 6.0, unit="m", minimum=0.1, maximum=1000.0, literal_only=True,
+                           doc="a detour this long that has not got past: FAILURE")
+    PASS_TURNS = InputPort("pass_turns", bool, False, literal_only=True,
+                           doc="a wish to turn on the spot passes in every phase (a child turning by a measured angle)")
+    MEMORY = InputPort("memory", float, 1.0, unit="s", minimum=0.0, maximum=10.0, literal_only=True,
+                       doc="range echoes are remembered this long (odometry frame)")
+    ROBOT_RADIUS = InputPort("robot_radius", float, 0.26, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
+                             doc="radius of a disc that holds the robot's footprint")
+    CHILD_COMMAND = InputPort("child_command", VelocityCommand, Ref("/robot/command"), unit="m/s, rad/s",
+                              doc="the command the child wrote this tick (its wish)")
+    RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path), doc=RANGES_KEY.doc)
+    SAFETY = InputPort("safety", SafetyState, Ref(SAFETY_KEY.path), doc=SAFETY_KEY.doc)
+    RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
+    PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, PASS_TURNS, MEMORY,
+             ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND)
+
+    def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
+        super().__init__(name=name, child=child, **ports)
+        self.settings = AvoidSettings(
+            disc(self.get_input(self.ROBOT_RADIUS)), clearance=self.get_input(self.CLEARANCE),
+            horizon=self.get_input(self.HORIZON), speed=self.get_input(self.SPEED),
+            turn_rate=math.radians(self.get_input(self.TURN_RATE)), max_stray=self.get_input(self.MAX_STRAY))
+        self.avoidance = Avoidance(self.settings, DetourSettings(
+            wait=self.get_input(self.WAIT), timeout=self.get_input(self.TIMEOUT),
+            max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS)))
+        self.memory = ObstacleMemory(self.get_input(self.MEMORY))
+        self.decision: Decision | None = None
+        self._events: list[str] = []
+        self._trail: list[list[float]] = []  # the current detour's odometry positions
+        self._detours: list[np.ndarray] = []  # every detour driven, for the recording
+        self._drawn = (0, False)  # (detours drawn, arcs drawn)
+
+    def update(self) -> Status:
+        child = self.decorated.status
+        if child != Status.RUNNING:
+            return child
+        if not self.get_input(self.ENABLED):
+            return Status.RUNNING
+        wish = self.get_input(self.CHILD_COMMAND, None)
+        pose = self.get_input(ODOMETRY, None)
+        if wish is None or pose is None:  # the child commands nothing this tick: nothing to judge
+            return Status.RUNNING
+        now = self.now()
+        scan = self.get_input(self.RANGES, None)
+        if scan is not None:
+            self.memory = self.memory.added(scan.points(), pose, scan.stamp)
+        safety = self.get_input(self.SAFETY, None)
+        stopped = safety is not None and safety.state == "stopped"
+        decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped)
+        self._record(decision, pose)
+        if decision.gave_up:
+            self.feedback_message = decision.gave_up
+            self.set_output(COMMAND, STOP)
+            return Status.FAILURE
+        if not decision.passed:
+            self.set_output(COMMAND, VelocityCommand(decision.v, decision.w))
+        self.feedback_message = "" if decision.phase == "clear" else decision.event or self.feedback_message
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status != Status.RUNNING and self._clock is not None:
+            self.avoidance.reset(self.now())
+            self._close_trail()
+
+    def _record(self, decision: Decision, pose: Pose2D) -> None:
+        self.decision = decision
+        if decision.event:
+            self._events.append(decision.event)
+        if decision.phase == "detour":
+            self._trail.append([pose.x, pose.y])
+        else:
+            self._close_trail()
+
+    def _close_trail(self) -> None:
+        if len(self._trail) > 1:
+            self._detours.append(np.array(self._trail))
+        self._trail = []
+
+    def figures(self) -> Iterator[Figure]:
+        """The ``avoidance`` section: this node's tallies under its name."""
+        tally = self.avoidance.tally
+        key = self.name.replace(".", "_")
+        values: dict[str, Any] = {
+            "waits": tally.waits, "waits_cleared": tally.waits_cleared, "wait_time_s": round(tally.wait_time, 2),
+            "detours": tally.detours, "detour_length_m": round(tally.detour_length, 3),
+            "detour_time_s": round(tally.detour_time, 2), "give_ups": tally.give_ups,
+            "reasons": tally.reasons[-REASONS_KEPT:]}
+        for name, value in values.items():
+            yield Figure("avoidance", f"{key}.{name}", value)
+
+    def drawings(self) -> Iterator[Drawing]:
+        """Events, the phase, the fan judged this tick (cleared once the way is clear) and the detours."""
+        for text in self._events:
+            yield Event("avoidance/events", text)
+        self._events = []
+        decision = self.decision
+        if decision is None:
+            return
+        yield Plot("avoidance/phase", PHASES[decision.phase])
+        detours, arcs_drawn = self._drawn
+        if decision.choice is not None:
+            yield from fan_drawings(decision.choice)
+            arcs_drawn = True
+        elif arcs_drawn and decision.phase == "clear":
+            yield Lines("avoidance/robot_frame/histogram", [], FREE)
+            yield Arrows("avoidance/robot_frame/chosen", np.zeros((0, 2)), CHOSEN)
+            arcs_drawn = False
+        if len(self._detours) != detours:
+            yield Lines("odometry_frame/avoidance/detours", list(self._detours), (255, 140, 0), radius=0.02)
+            detours = len(self._detours)
+        self._drawn = (detours, arcs_drawn)
+
+
+def fan_drawings(choice: Choice) -> Iterator[Drawing]:
+    """The histogram judged (robot frame): each direction as a ray as far as it is free, up to
+    :data:`DRAWN_REACH`, and the chosen direction."""
+    rays = [np.array([[0.0, 0.0], [math.cos(d.angle), math.sin(d.angle)]]) * min(d.free, DRAWN_REACH)
+            for d in choice.directions]
+    colours = [CHOSEN if i == choice.chosen else FREE if d.will_do(choice.reach) else BLOCKED
+               for i, d in enumerate(choice.directions)]
+    yield Lines("avoidance/robot_frame/histogram", rays, colours)
+    direction = choice.direction
+    if direction is not None:
+        yield Arrows("avoidance/robot_frame/chosen", np.array([[math.cos(direction.angle), math.sin(direction.angle)]]),
+                     CHOSEN)

@@ -1,0 +1,17 @@
+"""Getting around what blocks the way, from range points: the pure part of ``AvoidObstacles``.
+
+==============  =========================================================================
+module          what it holds
+==============  =========================================================================
+``sweep``       how far the footprint goes along an arc or in a direction before it
+                touches a point; how far a motion node means to go (is its arc free?)
+``directions``  the free direction closest to the wish (a polar histogram, VFH+) and the
+                command that takes it (an arc, or a turn on the spot first)
+``memory``      obstacle points of the last second, kept in the odometry frame
+``detour``      one tick's decision: pass the wish on, wait for the way to clear, detour,
+                or give up; the tallies the report gets (detours, length, time, waits)
+==============  =========================================================================
+
+Everything is in the base frame (REP-103: x forward, y left) unless a name says odometry.
+docs/obstacles.md is the overview.
+"""

@@ -1,0 +1,313 @@
+"""One tick of getting around what blocks the way: pass the wish on, wait, detour, or give up.
+
+A motion node wishes a command ``(v, w)``; :class:`Avoidance` decides, once per tick, what the
+base gets instead, from the obstacle points around the base (:mod:`maps.avoidance.memory`) and
+the robot's odometry. Three phases:
+
+- **clear**: the wish passes unchanged. A forward wish whose arc is not free for as far as it
+  means to go (:func:`maps.avoidance.sweep.needed_distance`), or one the collision monitor
+  stopped, holds the robot: it waits.
+- **waiting**: stopped, so that a person walking across can pass (a blocked way that changes by
+  itself costs no detour). The way clearing ends the wait; a way blocked again within
+  ``clear_time`` resumes the same wait (the clock keeps running). After ``wait`` seconds still
+  blocked, a detour starts when a direction will do (:func:`maps.avoidance.directions.choose`,
+  kept within ``max_stray`` of the line the robot was on when it was first held).
+- **detour**: every tick the free direction closest to the wish, on the side the detour took,
+  steered to (:func:`maps.avoidance.directions.steer`: an arc, or a turn on the spot first).
+  Once a forward wish's own arc is free again (as far as the detour needs, a hysteresis) the
+  wish passes; ``clear_time`` of that ends the detour, and the motion node steers back to its
+  path by itself. A wish to stop or to back away passes (the collision monitor judges it). Where
+  the wish heads is kept in the odometry frame from its last forward command, so that a wish to
+  turn on the spot (which says only which way) does not swing the choice as the robot turns. No
+  direction will do: stopped. With ``pass_turns`` a wish to turn on the spot passes in every
+  phase: a node that turns by a measured angle (the roadmap's random moves and scans) fails when
+  its turn does not happen.
+
+Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
+without a direction, for ``timeout`` seconds (a hold the motion node's ending cut short, a route
+follower losing the trail for a moment, goes on counting when the node starts again within
+:data:`RESTART_GAP` where the robot stood: otherwise a node that fails and is restarted every
+few seconds in front of a person would hold the robot for ever) ("blocked for 20 s by an obstacle 0.40 m ahead"), a
+detour longer than ``max_length`` metres that has not got past, or one that has turned by
+:data:`GOING_ROUND` (180 degrees): it is going round the obstacle, because what the motion node
+heads for is behind it or in it (a person standing where a viewframe was taught).
+
+Pure: no clock of its own (``now`` is passed in), no I/O; the tallies (:class:`Tally`) are what
+the run report's ``avoidance`` section shows.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from maps.avoidance.directions import Choice, choose, steer, wished_direction
+from maps.avoidance.sweep import AvoidSettings, DetourLine, Surroundings, free_distance, needed_distance
+from perception.geometry import Pose2D, wrap_angle
+from perception.polygons import distance
+
+Phase = Literal["clear", "waiting", "detour"]
+GOING_ROUND = math.pi  # rad: a detour that has turned this much is going round the obstacle, not past it
+RESTART_GAP = 2.0  # s: a hold cut short by the node's ending goes on when held again this soon ...
+STOOD = 0.05  # m: ... this close to where it was held
+
+
+@dataclass(frozen=True, slots=True)
+class DetourSettings:
+    """How long to wait, when to give up (module docstring)."""
+
+    wait: float = 2.0  # s held before a detour is tried
+    timeout: float = 20.0  # s held (waiting, or on a detour with no direction) before giving up
+    clear_time: float = 1.0  # s the way must stay clear to end a wait or a detour
+    max_length: float = 6.0  # m: a detour this long that has not got past gives up
+    pass_turns: bool = False  # a wish to turn on the spot passes in every phase (nodes that turn by a measured angle)
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    """What the base gets this tick, the phase after the tick and why."""
+
+    v: float
+    w: float
+    phase: Phase
+    choice: Choice | None = None  # the fan, when it was judged this tick
+    event: str = ""  # a line for the recording's event log ("" when nothing changed)
+    gave_up: str = ""  # the reason, when the avoidance gives up this tick
+    passed: bool = False  # the wish went on unchanged
+
+
+@dataclass
+class Tally:
+    """What the avoidance did over a run (the report's figures)."""
+
+    waits: int = 0  # times the robot was held for a blocked way
+    waits_cleared: int = 0  # ... of which the way cleared by itself (no detour)
+    wait_time: float = 0.0  # s held before the way cleared or a detour started
+    detours: int = 0
+    detour_length: float = 0.0  # m driven on detours (odometry)
+    detour_time: float = 0.0  # s
+    give_ups: int = 0
+    reasons: list[str] = field(default_factory=list)  # why, per give-up
+
+
+@dataclass
+class _Episode:
+    """A wait, and the detour it may turn into."""
+
+    since: float  # when the robot was first held
+    line: DetourLine
+    origin: float  # when the hold began, for the wait and the timeout: since, or a cut hold's (_held_since)
+    detour_start: float | None = None
+    length: float = 0.0
+    turned: float = 0.0  # rad, signed: the heading's change since the detour started
+    last: Pose2D | None = None
+    side: int = 0
+    goal: float | None = None  # rad, odometry: where the wish heads, from its last forward command
+    clear_since: float | None = None  # the way clear since (the wish passing again)
+    held_since: float | None = None  # on a detour with no direction (or stopped by the monitor) since
+    by_monitor: bool = False  # held because the collision monitor stopped a wish the arcs found free
+
+
+class Avoidance:
+    """Decides each tick's command for one motion node's wishes (module docstring)."""
+
+    def __init__(self, avoid: AvoidSettings, settings: DetourSettings | None = None) -> None:
+        self.avoid = avoid
+        self.settings = settings or DetourSettings()
+        self.tally = Tally()
+        self.phase: Phase = "clear"
+        self._episode: _Episode | None = None
+        self._pose: Pose2D | None = None  # the last tick's
+        self._cut: tuple[float, float, Pose2D] | None = None  # a hold that reset cut short: (since, when, where)
+
+    @property
+    def line(self) -> DetourLine | None:
+        """The line the current wait or detour started on (None while clear)."""
+        return self._episode.line if self._episode is not None else None
+
+    def step(self, v: float, w: float, points: np.ndarray, pose: Pose2D, now: float, *,
+             stopped: bool = False) -> Decision:
+        """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
+        robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command."""
+        if self.settings.pass_turns and v == 0.0 and w != 0.0:  # the monitor judges a turn on the spot
+            return Decision(v, w, self.phase, passed=True)
+        around = Surroundings.of(points, self.avoid)
+        self._pose = pose
+        episode = self._episode
+        if episode is not None and episode.detour_start is not None:
+            return self._detour(episode, v, w, around, pose, now, stopped)
+        blocked = self._blocked(v, w, around)
+        if self.phase == "clear":
+            if not blocked and not (stopped and v > 0.0):
+                self._settle(now)
+                return Decision(v, w, "clear", passed=True)
+            return self._hold(v, w, around, pose, now, by_monitor=not blocked)
+        assert episode is not None
+        if not blocked and not episode.by_monitor:  # the way cleared while waiting: count it once it stays clear
+            self.phase, episode.clear_since = "clear", now
+            return Decision(v, w, "clear", event=f"the way cleared after {now - episode.since:.1f} s", passed=True)
+        return self._wait(episode, v, w, around, pose, now)
+
+    def reset(self, now: float) -> None:
+        """End whatever is going on (the motion node ended or was halted), tallying it as it is."""
+        episode = self._episode
+        held = None if episode is None else episode.held_since if episode.detour_start is not None else \
+            None if self.phase == "clear" else episode.origin
+        self._cut = None if held is None or self._pose is None else (held, now, self._pose)
+        if episode is not None:
+            if episode.detour_start is not None:
+                self._end_detour(episode, now)
+            elif self.phase == "clear" and episode.clear_since is not None:
+                self._end_wait(episode, episode.clear_since, cleared=True)
+            else:
+                self.tally.wait_time += now - episode.since
+        self.phase, self._episode = "clear", None
+
+    # -- the phases ------------------------------------------------------------------------------
+    def _hold(self, v: float, w: float, around: Surroundings, pose: Pose2D, now: float, *, by_monitor: bool
+              ) -> Decision:
+        """A clear way is blocked: wait (or go on waiting, when it cleared only a moment ago). Held by
+        the monitor alone (the arcs find the wish free), the wait lasts until a detour starts."""
+        self._settle(now)
+        episode = self._episode
+        resumed = episode is not None and episode.clear_since is not None
+        if episode is None or not resumed:
+            episode = self._episode = _Episode(now, DetourLine.at(pose), self._held_since(pose, now))
+            self.tally.waits += 1
+        episode.clear_since = None
+        episode.by_monitor = episode.by_monitor or by_monitor
+        self.phase = "waiting"
+        ahead = "(the collision monitor stopped it)" if by_monitor else self._ahead(v, w, around.points)
+        return Decision(0.0, 0.0, "waiting", event="" if resumed else f"the way is blocked {ahead}: waiting")
+
+    def _wait(self, episode: _Episode, v: float, w: float, around: Surroundings, pose: Pose2D, now: float
+              ) -> Decision:
+        held = now - episode.origin
+        if held < self.settings.wait:
+            return Decision(0.0, 0.0, "waiting")
+        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v), pose=pose,
+                        line=episode.line)
+        if choice.direction is not None:
+            self._end_wait(episode, now, cleared=False)
+            episode.detour_start, episode.last, episode.side = now, pose, choice.side
+            self.phase = "detour"
+            self.tally.detours += 1
+            side = {1: "left", -1: "right"}.get(choice.side, "ahead")
+            return Decision(*steer(choice, around, self.avoid), "detour", choice,
+                            f"detour to the {side} after {held:.1f} s")
+        if held >= self.settings.timeout:
+            return self._give_up(self._blocked_reason(held, v, w, around.points, choice), now)
+        return Decision(0.0, 0.0, "waiting", choice)
+
+    def _detour(self, episode: _Episode, v: float, w: float, around: Surroundings, pose: Pose2D, now: float,
+                stopped: bool) -> Decision:
+        if episode.last is not None:
+            episode.length += math.hypot(pose.x - episode.last.x, pose.y - episode.last.y)
+            episode.turned += wrap_angle(pose.theta - episode.last.theta)
+        episode.last = pose
+        if episode.length > self.settings.max_length:
+            return self._give_up(f"a detour of {episode.length:.1f} m did not get past the obstacle "
+                                 f"(at most {self.settings.max_length:g} m)", now)
+        if abs(episode.turned) > GOING_ROUND:
+            return self._give_up(f"the detour turned {math.degrees(abs(episode.turned)):.0f} deg: it goes round the "
+                                 "obstacle, not past it", now)
+        if v < 0.0 or (v == 0.0 and w == 0.0):  # backing away (from a stall), stopping: the monitor's to judge
+            episode.clear_since = None
+            return Decision(v, w, "detour", passed=True)
+        if v > 0.0 and not stopped and not self._blocked(v, w, around, at_least=self._reach(v)):
+            episode.held_since = None
+            episode.clear_since = now if episode.clear_since is None else episode.clear_since
+            if now - episode.clear_since >= self.settings.clear_time:
+                length, took = episode.length, now - (episode.detour_start or now)
+                self._end_detour(episode, now)
+                self.phase, self._episode = "clear", None
+                return Decision(v, w, "clear", event=f"past the obstacle: a detour of {length:.2f} m in {took:.1f} s",
+                                passed=True)
+            return Decision(v, w, "detour", passed=True)
+        episode.clear_since = None
+        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v),
+                        side=episode.side, pose=pose, line=episode.line)
+        command = steer(choice, around, self.avoid)
+        if choice.direction is not None and not stopped and command != (0.0, 0.0):
+            episode.held_since = None
+        else:  # no direction will do, none that moves the robot, or the monitor stopped the last command: held
+            episode.held_since = now if episode.held_since is None else episode.held_since
+            if now - episode.held_since >= self.settings.timeout:
+                return self._give_up(self._blocked_reason(now - episode.held_since, v, w, around.points, choice), now)
+        episode.side = episode.side or choice.side
+        return Decision(*command, "detour", choice)
+
+    def _held_since(self, pose: Pose2D, now: float) -> float:
+        """When a new hold began: now, or when a hold cut short by the node's ending began, if the
+        robot is held again soon after where it stood (module docstring)."""
+        cut, self._cut = self._cut, None
+        if cut is None:
+            return now
+        since, when, where = cut
+        near = math.hypot(pose.x - where.x, pose.y - where.y) <= STOOD
+        return since if near and now - when <= RESTART_GAP else now
+
+    def _give_up(self, reason: str, now: float) -> Decision:
+        self.reset(now)
+        self._cut = None
+        self.tally.give_ups += 1
+        self.tally.reasons.append(reason)
+        return Decision(0.0, 0.0, "clear", event=f"gave up: {reason}", gave_up=reason)
+
+    # -- tallies ---------------------------------------------------------------------------------
+    def _settle(self, now: float) -> None:
+        """A wait whose way has stayed clear for ``clear_time`` is over."""
+        episode = self._episode
+        if episode is not None and episode.clear_since is not None and \
+                now - episode.clear_since >= self.settings.clear_time:
+            self._end_wait(episode, episode.clear_since, cleared=True)
+            self._episode = None
+
+    def _end_wait(self, episode: _Episode, end: float, *, cleared: bool) -> None:
+        self.tally.wait_time += end - episode.since
+        self.tally.waits_cleared += int(cleared)
+
+    def _end_detour(self, episode: _Episode, now: float) -> None:
+        self.tally.detour_length += episode.length
+        self.tally.detour_time += now - (episode.detour_start or now)
+
+    # -- judging the wish ------------------------------------------------------------------------
+    def _blocked(self, v: float, w: float, around: Surroundings, at_least: float = 0.0) -> bool:
+        """Is a forward wish's arc not free for as far as it means to go (or ``at_least`` that far), or
+        does it graze a point already within the clearance? Turns on the spot and backing away are
+        the collision monitor's to judge."""
+        if v <= 0.0:
+            return False
+        return not around.open(v, w, max(needed_distance(v, self.avoid), at_least))
+
+    def _ahead(self, v: float, w: float, points: np.ndarray) -> str:
+        """Where the obstacle is, in words: along the wish's arc, or the nearest point."""
+        if len(points) == 0:
+            return "ahead"
+        along = free_distance(self.avoid.footprint, points, v, w) if v > 0.0 else math.inf
+        if math.isfinite(along):
+            return f"{along:.2f} m ahead"
+        return f"{float(distance(self.avoid.footprint, points).min()):.2f} m away"
+
+    def _blocked_reason(self, held: float, v: float, w: float, points: np.ndarray, choice: Choice) -> str:
+        reason = f"blocked for {held:.0f} s by an obstacle {self._ahead(v, w, points)}"
+        if choice.only_straying:
+            reason += f"; no way around within {self.avoid.max_stray:g} m of the path"
+        return reason
+
+    def _wish(self, episode: _Episode, v: float, w: float, pose: Pose2D) -> float:
+        """Where the wish heads from the robot's heading now (rad). A forward command says it (eq. 4),
+        and is remembered in the odometry frame; a turn on the spot says only which way, so the
+        remembered heading stands for it (the turn's way while there is none), and the choice does
+        not swing as the robot turns."""
+        if v > 0.0 or episode.goal is None:
+            episode.goal = pose.theta + wished_direction(v, w, self.avoid)
+        return float(np.clip(wrap_angle(episode.goal - pose.theta), -self.avoid.spread, self.avoid.spread))
+
+    def _reach(self, v: float) -> float:
+        """How far a detour's direction must be free: as far as the detour's speed needs, or the wish's,
+        the farther (a direction taken instead of the wish is free in the sense the wish was blocked)."""
+        return max(needed_distance(self.avoid.speed, self.avoid), needed_distance(v, self.avoid))

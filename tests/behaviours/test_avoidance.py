@@ -1,0 +1,141 @@
+"""AvoidObstacles around a Drive, with a hand-set Pioneer 3-DX sonar ring and a manual clock.
+
+A person 0.6 m ahead: the front transducers 3 and 4 (at (0.166, +-0.027), facing +-10 deg) read
+0.45 m, echoes at (0.609, +-0.105). The simulator's 0.26 m disc grown by the 0.1 m clearance
+meets them after 0.609 - sqrt(0.36^2 - 0.105^2) = 0.265 m, short of the 0.33 m a 0.3 m/s Drive
+needs (0.3^2 / 0.5 + 0.3 * 0.5): the way is blocked.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from py_trees.common import Status
+
+from behaviours.avoidance import AvoidObstacles
+from behaviours.motion import Drive
+from behaviours.telemetry import Event, Lines, Plot, report_sections
+from behaviours.testing import BehaviourHarness
+from drivers.interfaces import VelocityCommand
+from drivers.pioneer_body import BODIES
+from perception.collision_monitor import SafetyState
+from perception.geometry import Pose2D
+from perception.ranges import RangeScan
+
+RING = BODIES["p3dx"].sensors()
+PERSON_AHEAD = {3: 0.45, 4: 0.45}
+BOXED_IN = {i: 0.2 for i in range(8)}  # every front transducer 0.2 m from something
+
+
+def scan(echoes: dict[int, float], stamp: float) -> RangeScan:
+    ranges = np.full(len(RING), math.inf)
+    for i, r in echoes.items():
+        ranges[i] = r
+    return RangeScan(RING, ranges, stamp)
+
+
+def harness(echoes: dict[int, float], **ports: object) -> BehaviourHarness:
+    node = AvoidObstacles(name="avoid", child=Drive(distance=5.0), **ports)
+    return BehaviourHarness(node, blackboard={"/robot/odometry": Pose2D(), "/robot/ranges": scan(echoes, 0.0)})
+
+
+def sense(h: BehaviourHarness, echoes: dict[int, float], pose: Pose2D | None = None) -> None:
+    """What the sensing branch writes before a tick: the ring read now, the odometry."""
+    h.write("/robot/ranges", scan(echoes, h.clock.now()))
+    if pose is not None:
+        h.write("/robot/odometry", pose)
+
+
+def command(h: BehaviourHarness) -> tuple[float, float]:
+    c = h.read("/robot/command")
+    return (c.v, c.w) if c is not None else (math.nan, math.nan)
+
+
+def test_a_clear_way_passes_the_childs_command_unchanged():
+    h = harness({})
+    assert h.tick() == Status.RUNNING
+    assert command(h) == (0.3, 0.0)  # Drive's own, at its top speed
+    assert report_sections(h.behaviour)["avoidance"]["avoid"]["waits"] == 0
+
+
+def test_a_person_walking_across_is_waited_for_and_the_child_drives_on():
+    h = harness(PERSON_AHEAD)
+    assert h.tick() == Status.RUNNING and command(h) == (0.0, 0.0)
+    assert h.behaviour.feedback_message.startswith("the way is blocked 0.3")
+    for _ in range(10):  # a second: they walk past
+        h.clock.advance(0.1)
+        sense(h, PERSON_AHEAD)
+        h.tick()
+        assert command(h) == (0.0, 0.0)
+    h.clock.advance(1.0)  # the echoes of the last second are forgotten
+    sense(h, {})
+    assert h.tick() == Status.RUNNING and command(h) == (0.3, 0.0)
+    h.clock.advance(1.0)
+    sense(h, {})
+    h.tick()
+    figures = report_sections(h.behaviour)["avoidance"]["avoid"]
+    assert (figures["waits"], figures["waits_cleared"], figures["detours"]) == (1, 1, 0)
+    assert figures["wait_time_s"] == pytest.approx(2.0)
+
+
+def test_what_stays_in_the_way_is_driven_round_after_the_wait():
+    h = harness(PERSON_AHEAD, wait=2.0)
+    status = h.tick_until(lambda s: h.behaviour.decision.phase == "detour", between=lambda h: sense(h, PERSON_AHEAD))
+    assert status == Status.RUNNING and h.clock.now() == pytest.approx(2.0)
+    v, w = command(h)
+    assert (v, w) != (0.0, 0.0) and w != 0.0  # turning away from the person (on the spot, or along an arc)
+    drawn = list(h.behaviour.drawings())
+    assert Event("avoidance/events", "the way is blocked 0.37 m ahead: waiting") in drawn
+    assert any(isinstance(d, Event) and d.text.startswith("detour to the ") for d in drawn)
+    histogram = next(d for d in drawn if isinstance(d, Lines) and d.entity == "avoidance/robot_frame/histogram")
+    assert len(histogram.strips) == 25 and Plot("avoidance/phase", 2.0) in drawn
+    assert report_sections(h.behaviour)["avoidance"]["avoid"]["detours"] == 1
+
+
+def test_boxed_in_it_gives_up_after_the_timeout_and_halts_the_child():
+    h = harness(BOXED_IN, timeout=5.0)
+    status = h.tick_until(between=lambda h: sense(h, BOXED_IN))
+    assert status == Status.FAILURE and h.clock.now() == pytest.approx(5.0, abs=0.11)
+    assert h.behaviour.feedback_message.startswith("blocked for 5 s by an obstacle 0.1")
+    assert h.behaviour.feedback_message.endswith(" m ahead")
+    assert command(h) == (0.0, 0.0) and h.behaviour.decorated.status == Status.INVALID
+    figures = report_sections(h.behaviour)["avoidance"]["avoid"]
+    assert figures["give_ups"] == 1 and figures["reasons"] == [h.behaviour.feedback_message]
+
+
+def test_a_detour_that_would_stray_too_far_from_the_path_gives_up_saying_so():
+    # held at the origin heading +x; then 0.95 m to the left of that line with the way ahead and to
+    # the right blocked: the free directions all lead more than max_stray (1 m) from it
+    h = harness(PERSON_AHEAD, wait=0.0, timeout=3.0, max_stray=1.0)
+    h.tick()
+    blocked = {2: 0.3, 3: 0.3, 4: 0.3, 5: 0.3, 6: 0.3, 7: 0.3}
+    aside = Pose2D(0.6, 0.95, 0.0)
+    status = h.tick_until(between=lambda h: sense(h, blocked, aside))
+    assert status == Status.FAILURE
+    assert h.behaviour.feedback_message.endswith("; no way around within 1 m of the path")
+
+
+def test_a_stop_of_the_collision_monitor_holds_the_child_too():
+    h = harness({})
+    h.write("/robot/safety", SafetyState(state="stopped", action="bumper", zone="front bumper"))
+    h.tick()
+    assert command(h) == (0.0, 0.0)
+    assert h.behaviour.feedback_message == "the way is blocked (the collision monitor stopped it): waiting"
+
+
+def test_disabled_or_blind_it_passes_every_command():
+    disabled = harness(BOXED_IN, enabled=False)
+    assert disabled.tick() == Status.RUNNING and command(disabled) == (0.3, 0.0)
+    blind = BehaviourHarness(AvoidObstacles(name="avoid", child=Drive(distance=5.0)),
+                             blackboard={"/robot/odometry": Pose2D()})  # no /robot/ranges: no range sensors
+    assert blind.tick() == Status.RUNNING and command(blind) == (0.3, 0.0)
+
+
+def test_its_status_is_the_childs():
+    h = harness({})
+    assert h.tick() == Status.RUNNING
+    h.write("/robot/odometry", Pose2D(5.0, 0.0, 0.0))  # Drive got there
+    assert h.tick() == Status.SUCCESS
+    assert h.read("/robot/command") == VelocityCommand(0.0, 0.0)

@@ -1,0 +1,169 @@
+"""The avoidance's phases on a hand-set clock: pass, wait for a person to pass, detour, give up.
+
+The robot is the simulator's 0.26 m disc; a person straight ahead is a point 0.6 m from its centre:
+0.34 m from the disc, 0.24 m from the disc grown by the 0.1 m clearance, short of what a 0.3 m/s
+wish needs (0.3^2 / 0.5 + 0.3 * 0.5 = 0.33 m).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from maps.avoidance.detour import Avoidance, DetourSettings
+from maps.avoidance.sweep import AvoidSettings
+from perception.geometry import Pose2D
+from perception.polygons import disc
+
+NOTHING = np.zeros((0, 2))
+PERSON = np.array([[0.6, 0.0]])
+BOXED_IN = np.array([[0.45 * np.cos(a), 0.45 * np.sin(a)] for a in np.linspace(-np.pi / 2, np.pi / 2, 13)])
+HERE = Pose2D()
+
+
+def avoidance(**detour: float | bool) -> Avoidance:
+    return Avoidance(AvoidSettings(disc(0.26)), DetourSettings(**detour))
+
+
+def test_a_free_way_and_anything_but_driving_forwards_pass_unchanged():
+    a = avoidance()
+    assert a.step(0.3, 0.1, NOTHING, HERE, 0.0).passed
+    assert a.step(0.3, 0.1, np.array([[2.0, 0.0]]), HERE, 0.1).passed  # 1.64 m away: free for far more than 0.33
+    turn = a.step(0.0, 0.5, BOXED_IN, HERE, 0.2)  # turning on the spot and backing: the monitor's to judge
+    back = a.step(-0.1, 0.0, BOXED_IN, HERE, 0.3)
+    assert turn.passed and back.passed and a.tally.waits == 0
+
+
+def test_a_person_walking_across_is_waited_for():
+    a = avoidance()
+    held = a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    assert (held.v, held.w, held.phase, held.passed) == (0.0, 0.0, "waiting", False)
+    assert held.event == "the way is blocked 0.34 m ahead: waiting"
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.5).phase == "waiting"
+    gone = a.step(0.3, 0.0, NOTHING, HERE, 1.2)  # they walked on
+    assert gone.passed and gone.event == "the way cleared after 1.2 s"
+    assert a.tally.waits == 1 and a.tally.waits_cleared == 0  # counted once the way has stayed clear ...
+    a.step(0.3, 0.0, NOTHING, HERE, 2.2)
+    assert (a.tally.waits_cleared, a.tally.wait_time, a.tally.detours) == (1, pytest.approx(1.2), 0)
+
+
+def test_a_way_blocked_again_at_once_resumes_the_same_wait():
+    a = avoidance(wait=2.0)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    a.step(0.3, 0.0, NOTHING, HERE, 0.5)  # a missed echo
+    again = a.step(0.3, 0.0, PERSON, HERE, 0.6)
+    assert again.phase == "waiting" and again.event == "" and a.tally.waits == 1
+    assert a.step(0.3, 0.0, PERSON, HERE, 2.0).phase == "detour"  # 2 s after the first hold, not the second
+
+
+def test_a_person_standing_still_is_driven_around_after_the_wait():
+    a = avoidance(wait=2.0)
+    for t in np.arange(0.0, 2.0, 0.1):
+        assert a.step(0.3, 0.0, PERSON, HERE, float(t)).phase == "waiting"
+    detour = a.step(0.3, 0.0, PERSON, HERE, 2.0)
+    assert detour.phase == "detour" and detour.choice is not None and detour.choice.direction is not None
+    side = np.sign(detour.choice.direction.angle)
+    assert detour.w == pytest.approx(side * np.radians(45.0))  # more than 30 deg off the heading: turn first
+    assert detour.v == 0.0 and detour.event == f"detour to the {'left' if side > 0 else 'right'} after 2.0 s"
+    # the person left behind: the wish's own arc is free again, it passes, and after clear_time the detour ends
+    past = Pose2D(0.8, 0.3 * side, 0.0)
+    assert a.step(0.3, 0.0, NOTHING, past, 2.5).passed
+    end = a.step(0.3, 0.0, NOTHING, past, 3.5)
+    assert end.phase == "clear" and end.event.startswith("past the obstacle: a detour of 0.85 m")
+    assert (a.tally.detours, a.tally.detour_length, a.tally.detour_time) == (1, pytest.approx(0.854, abs=1e-3),
+                                                                             pytest.approx(1.5))
+    assert a.tally.wait_time == pytest.approx(2.0)
+
+
+def test_boxed_in_it_gives_up_after_the_timeout_with_the_reason():
+    a = avoidance(wait=2.0, timeout=20.0)
+    for t in np.arange(0.0, 20.0, 0.5):
+        decision = a.step(0.3, 0.0, BOXED_IN, HERE, float(t))
+        assert decision.phase == "waiting" and not decision.gave_up
+    gave_up = a.step(0.3, 0.0, BOXED_IN, HERE, 20.0)
+    assert (gave_up.v, gave_up.w) == (0.0, 0.0)
+    assert gave_up.gave_up == "blocked for 20 s by an obstacle 0.19 m ahead"
+    assert a.tally.give_ups == 1 and a.tally.reasons == [gave_up.gave_up] and a.phase == "clear"
+
+
+def test_a_hold_cut_short_by_the_nodes_ending_goes_on_counting_where_the_robot_stood():
+    # a route follower that loses the trail for a moment in front of a person ends and starts again
+    a = avoidance(wait=2.0, timeout=5.0)
+    a.step(0.3, 0.0, BOXED_IN, HERE, 0.0)
+    a.reset(1.5)
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 1.7).event == "the way is blocked 0.19 m ahead: waiting"
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 4.9).gave_up == ""
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 5.0).gave_up.startswith("blocked for 5 s by an obstacle")
+    assert a.tally.waits == 2 and a.tally.wait_time == pytest.approx(1.5 + 3.3)  # each hold once
+    b = avoidance(wait=2.0, timeout=5.0)  # held again elsewhere, or later: a new hold
+    b.step(0.3, 0.0, BOXED_IN, HERE, 0.0)
+    b.reset(1.5)
+    b.step(0.3, 0.0, BOXED_IN, Pose2D(0.1, 0.0, 0.0), 1.7)
+    assert b.step(0.3, 0.0, BOXED_IN, Pose2D(0.1, 0.0, 0.0), 6.6).gave_up == ""
+    b.reset(6.6)
+    b.step(0.3, 0.0, BOXED_IN, Pose2D(0.1, 0.0, 0.0), 9.0)
+    assert b.step(0.3, 0.0, BOXED_IN, Pose2D(0.1, 0.0, 0.0), 13.0).gave_up == ""
+
+
+def test_a_detour_whose_command_does_not_move_the_robot_is_held_and_times_out(monkeypatch):
+    a = avoidance(wait=0.0, timeout=5.0)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.1).phase == "detour"
+    monkeypatch.setattr("maps.avoidance.detour.steer", lambda *_: (0.0, 0.0))  # a direction, but no motion to it
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.2).gave_up == ""
+    assert a.step(0.3, 0.0, PERSON, HERE, 5.2).gave_up.startswith("blocked for 5 s by an obstacle")
+
+
+def test_with_pass_turns_a_turn_on_the_spot_passes_while_waiting_and_on_a_detour():
+    a = avoidance(wait=0.0, pass_turns=True)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    assert a.phase == "waiting" and a.step(0.0, 0.5, PERSON, HERE, 0.1).passed
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.2).phase == "detour"
+    turn = a.step(0.0, -0.5, PERSON, HERE, 0.3)
+    assert turn.passed and (turn.v, turn.w, turn.phase) == (0.0, -0.5, "detour")
+    steered = avoidance(wait=0.0)  # without it, the detour steers a turn wish to its own direction
+    steered.step(0.3, 0.0, PERSON, HERE, 0.0)
+    steered.step(0.3, 0.0, PERSON, HERE, 0.1)
+    assert not steered.step(0.0, -0.5, PERSON, HERE, 0.2).passed
+
+
+def test_a_detour_that_would_stray_too_far_holds_and_gives_up_saying_so():
+    a = avoidance(wait=0.0, timeout=5.0)
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.0).phase == "waiting"
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.1).phase == "detour"  # held at the origin, heading +x
+    # 1.45 m to the left of that line now, something ahead and on the right: only the directions to the
+    # left are free, and they end beyond 1.5 m
+    wall = np.array([[0.5 * np.cos(a), 0.5 * np.sin(a)] for a in np.linspace(-2.2, 0.3, 12)])
+    aside = Pose2D(0.5, 1.45, 0.0)
+    held = a.step(0.3, 0.0, wall, aside, 0.2)
+    assert held.choice is not None and held.choice.only_straying and (held.v, held.w) == (0.0, 0.0)
+    gave_up = a.step(0.3, 0.0, wall, aside, 5.2)
+    assert gave_up.gave_up.startswith("blocked for 5 s by an obstacle ")
+    assert gave_up.gave_up.endswith("; no way around within 1.5 m of the path")
+
+
+def test_a_detour_longer_than_max_length_gives_up():
+    a = avoidance(wait=0.0, max_length=1.0)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    a.step(0.3, 0.0, PERSON, HERE, 0.1)
+    assert a.step(0.3, 0.0, PERSON, Pose2D(0.6, 0.0, 0.0), 0.2).phase == "detour"
+    gave_up = a.step(0.3, 0.0, PERSON, Pose2D(1.2, 0.0, 0.0), 0.3)
+    assert gave_up.gave_up == "a detour of 1.2 m did not get past the obstacle (at most 1 m)"
+
+
+def test_a_stop_of_the_collision_monitor_holds_the_robot_until_a_detour():
+    a = avoidance(wait=1.0)
+    held = a.step(0.3, 0.0, NOTHING, HERE, 0.0, stopped=True)  # a bumper, or a point the scan does not show
+    assert held.phase == "waiting" and held.event == "the way is blocked (the collision monitor stopped it): waiting"
+    assert a.step(0.3, 0.0, NOTHING, HERE, 0.5).phase == "waiting"  # the stop of a zero command says nothing
+    assert a.step(0.3, 0.0, NOTHING, HERE, 1.0).phase == "detour"
+
+
+def test_reset_tallies_what_was_going_on():
+    a = avoidance(wait=0.0)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    a.step(0.3, 0.0, PERSON, HERE, 0.5)
+    a.step(0.3, 0.0, PERSON, Pose2D(0.3, 0.0, 0.0), 1.0)
+    a.reset(2.0)
+    assert (a.tally.detours, a.tally.detour_length, a.tally.detour_time) == (1, pytest.approx(0.3), pytest.approx(1.5))
+    assert a.phase == "clear" and a.line is None
