@@ -84,7 +84,8 @@ class Recorder:
             for figure in node.figures():
                 value = figure.value
                 if isinstance(value, (int, float)) and not isinstance(value, bool):
-                    entity = f"figures/{figure.section}/{figure.name.replace('.', '/')}"
+                    parts = [figure.section, *figure.name.split(".")]  # a node's name may hold spaces
+                    entity = "figures/" + "/".join(self.rr.escape_entity_path_part(p) for p in parts)
                     if self._last_figure.get(entity) != value:
                         self._last_figure[entity] = value
                         self.rr.log(entity, self.rr.Scalars([float(value)]))

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 import py_trees
+import rerun
 
 from behaviours.telemetry import Arrows, Drawing, Event, Figure, Lines, Picture, Plot, Points
 from missions.images import ImageRate
@@ -22,6 +23,10 @@ class _FakeRerun:
 
     def __getattr__(self, name: str) -> Any:
         return lambda *args, **kwargs: (name, {"args": args, **kwargs})
+
+    @staticmethod
+    def escape_entity_path_part(part: str) -> str:
+        return rerun.escape_entity_path_part(part)
 
 
 class _Node:
@@ -68,6 +73,19 @@ def test_a_figure_is_plotted_only_when_it_changes():
         recorder.log_node(node)
     plotted = [kwargs["args"][0] for entity, _, kwargs in fake.logged if entity == "figures/ltmap/search/scans"]
     assert plotted == [[0.0], [1.0], [2.0]]
+
+
+def test_a_figure_of_a_node_named_in_words_is_one_entity_path_part_per_name():
+    recorder, fake = _recorder()
+
+    class Named(_Node):
+        def figures(self) -> Iterator[Figure]:
+            yield Figure("avoidance", "around obstacles on the tour.detours", 2)
+
+    recorder.log_node(Named())
+    # the node's name is one part, its spaces escaped (rerun warned of unescaped whitespace before)
+    assert [entity for entity, _, _ in fake.logged if entity.startswith("figures/")] == [
+        "figures/avoidance/around\\ obstacles\\ on\\ the\\ tour/detours"]
 
 
 def test_figures_are_gathered_at_most_once_a_second_of_the_run():
