@@ -34,14 +34,6 @@ disparities) and may be looking sideways:
   drove along); a tall obstacle there would have been seen ahead, from farther away, by cameras
   looking where the robot goes. The goal itself is a border point, next to the unknown: the robot
   stops about a radius before it unless the cameras see beyond it first.
-- **Looked at and still unseen**: the stop before unseen floor is where the cameras had their last
-  chance (the floor there is by then within the disc's reach, ~0.3 m from the centre: nearer than
-  the cameras ever see). Held there ``hold`` seconds with the gaze on it (``unseen_ahead``), the
-  robot crawls on, its own disc sweeping that floor free (:func:`maps.exploration.grid.mark_traversed`),
-  the stop waived until its centre is a radius from where it was released. Without this the robot
-  stood for ever where the unseen floor was hidden from every view it had (in one simulated run 850 s
-  between a pillar and a table, a patch of unknown floor 0.25-0.4 m beside it, 42 goals given up as
-  stuck: a stop is only worth something while the cameras can still see the floor).
 - **Progress**: no metre of path gained for ``stuck_time`` seconds (a stop before unseen floor the
   cameras cannot see from here: nearer than their ~0.5 m blind zone): FAILURE, so that a recovery
   looks around and the goal is chosen again.
@@ -178,13 +170,11 @@ class FollowPath(BearingsBehaviour):
                       doc="the speed from there on, until the disc would touch it")
     FRONT = InputPort("front", float, 60.0, unit="deg", minimum=0.0, maximum=180.0, literal_only=True,
                       doc="unseen floor within this of the direction of travel holds the robot (180: the whole disc)")
-    HOLD = InputPort("hold", float, 3.0, unit="s", minimum=0.0, maximum=600.0, literal_only=True,
-                     doc="stopped before unseen floor this long (the cameras looking at it), crawl on over it")
     UNSEEN_AHEAD: OutputPort[Pose2D | None] = OutputPort(
         "unseen_ahead", Pose2D, "/robot/unseen_ahead",
         doc="the first point of the path ahead whose disc covers unseen floor (None: none)")
     PORTS = (SPEED, SPEED_LIMIT, TURN_RATE, TOLERANCE, LOOKAHEAD, TURN_IN_PLACE, CHECK_DISTANCE, CLEARANCE,
-             ROBOT_RADIUS, MARGIN, PENALTY, BACKOFF, MAX_STALLS, GUARD, STUCK_TIME, UNSEEN_MARGIN, CRAWL, FRONT, HOLD,
+             ROBOT_RADIUS, MARGIN, PENALTY, BACKOFF, MAX_STALLS, GUARD, STUCK_TIME, UNSEEN_MARGIN, CRAWL, FRONT,
              GOAL, MAP, POSE, STALLED, COMMAND, UNSEEN_AHEAD)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
@@ -200,9 +190,6 @@ class FollowPath(BearingsBehaviour):
         self.blind_stops = 0
         self.stuck = 0
         self.progress: tuple[float, float] = (math.inf, 0.0)  # best path length left, and when
-        self.held_since: float | None = None  # when the robot stopped before unseen floor
-        self.released: np.ndarray | None = None  # where it was let on over unseen floor it could not see
-        self.releases = 0
         self._drawn: np.ndarray | None = None  # the path last drawn
 
     def initialise(self) -> None:
@@ -241,7 +228,6 @@ class FollowPath(BearingsBehaviour):
             self.goal, self.path, self.index = goal, np.asarray(goal.path), 0
             if fresh:
                 self.stalls, self.progress = 0, (math.inf, self.now())
-                self.held_since, self.released = None, None
         return self._follow(pose, m, goal)
 
     def _follow(self, pose: Pose2D, m: ExplorationMap, goal: Goal) -> Status:
@@ -273,14 +259,12 @@ class FollowPath(BearingsBehaviour):
         top_w = math.radians(self.get_input(self.TURN_RATE))
         w = ramp(error, top_w, ANGULAR_DECEL, 0.0) if error else 0.0
         seen = self._seen_distance(m, here)
-        if seen > m.frame.resolution:
-            self.held_since = None
         if abs(error) > math.radians(self.get_input(self.TURN_IN_PLACE)):
             self.command(0.0, w)
             self.feedback_message = f"turning towards the path ({math.degrees(error):+.0f} deg)"
             return Status.RUNNING
         see = self.get_input(self.UNSEEN_MARGIN)  # brake to a crawl where the cameras can still see it
-        crawl = self.get_input(self.CRAWL) if seen > m.frame.resolution or self._released(here) else 0.0
+        crawl = self.get_input(self.CRAWL) if seen > m.frame.resolution else 0.0
         blind = max(math.sqrt(2.0 * LINEAR_DECEL * max(seen - see, 0.0)), crawl)
         v = min(ramp(remaining, self.get_input(self.SPEED), LINEAR_DECEL, 0.02),
                 self.get_input(self.SPEED_LIMIT, math.inf), blind)
@@ -295,20 +279,6 @@ class FollowPath(BearingsBehaviour):
         self.command(v, w)
         self.feedback_message = f"{remaining:.2f} m to go" + ("" if math.isinf(seen) else f", {seen:.2f} m seen")
         return Status.RUNNING
-
-    def _released(self, here: np.ndarray) -> bool:
-        """At the stop before unseen floor: has it been held there ``hold`` seconds (then it is let on,
-        and stays so until its centre is ``robot_radius`` from here)?"""
-        if self.released is not None and math.dist(self.released, here) <= self.get_input(ROBOT_RADIUS):
-            return True
-        self.released = None
-        if self.held_since is None:
-            self.held_since = self.now()
-        if self.now() - self.held_since < self.get_input(self.HOLD):
-            return False
-        self.released, self.held_since = here.copy(), None
-        self.releases += 1
-        return True
 
     def _nearest(self, here: np.ndarray) -> int:
         """The path point nearest the robot, searching forward from the last one (no going back)."""
@@ -366,8 +336,7 @@ class FollowPath(BearingsBehaviour):
         """The ``exploration`` section's driving part: stalls, re-plans, safety stops."""
         yield from (Figure("exploration", name, value) for name, value in (
             ("stalls", self.total_stalls), ("replans", self.replans), ("stuck", self.stuck),
-            ("safety_stops", self.safety_stops), ("blind_stops", self.blind_stops),
-            ("blind_releases", self.releases)))
+            ("safety_stops", self.safety_stops), ("blind_stops", self.blind_stops)))
 
     def drawings(self) -> Iterator[Drawing]:
         """The path being followed (odometry frame), when it changed."""
