@@ -27,21 +27,10 @@ MIN_TURN = math.radians(2.0)  # rad/s
 HEADING_GAIN = 1.5  # 1/s, holds the heading while driving straight
 
 
-def ramp(remaining: float, top: float, decel: float, floor: float, horizon: float = 0.0) -> float:
-    """Speed for ``remaining`` distance (signed): capped at ``top``, able to stop in time.
-
-    With a ``horizon`` (s), the speed ``v`` whose braking distance plus ``horizon`` of travel is the
-    distance left, ``v^2 / (2 a) + v h = d``, i.e. ``v = sqrt((a h)^2 + 2 a d) - a h`` (eq. 1 of
-    docs/obstacles.md solved for ``v``): the way an ``AvoidObstacles`` judges such a command then
-    ends at the goal, so something just beyond the goal does not hold the robot short of it."""
-    lag = decel * horizon
-    speed = min(top, math.sqrt(lag * lag + 2.0 * decel * abs(remaining)) - lag)  # eq. 1 for v (h = 0: sqrt(2 a d))
+def ramp(remaining: float, top: float, decel: float, floor: float) -> float:
+    """Speed for ``remaining`` distance (signed): capped at ``top``, able to stop in time."""
+    speed = min(top, math.sqrt(2.0 * decel * abs(remaining)))
     return math.copysign(max(speed, floor), remaining)
-
-
-HORIZON = InputPort("horizon", float, 0.0, unit="s", minimum=0.0, maximum=10.0,
-                    doc="slow down near the goal so the braking distance plus this much travel ends there "
-                        "(an AvoidObstacles' horizon: its judged way then ends at the goal)")
 
 
 ODOMETRY = InputPort("odometry", Pose2D, Ref("/robot/odometry"), doc="the base's pose in the odometry frame")
@@ -95,7 +84,7 @@ class Drive(OdometryMotion):
     DISTANCE = InputPort("distance", float, unit="m", doc="signed distance along the starting heading")
     SPEED = InputPort("speed", float, 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2)
     TOLERANCE = InputPort("tolerance", float, 0.01, unit="m", doc="close enough", minimum=0.001)
-    PORTS = (DISTANCE, SPEED, TOLERANCE, HORIZON, *MOTION_PORTS)
+    PORTS = (DISTANCE, SPEED, TOLERANCE, *MOTION_PORTS)
 
     def initialise(self) -> None:
         self._start: Pose2D | None = self.odometry()
@@ -109,7 +98,7 @@ class Drive(OdometryMotion):
         if abs(remaining) <= self.get_input(self.TOLERANCE):
             self.command(0.0, 0.0)
             return Status.SUCCESS
-        v = ramp(remaining, self.get_input(self.SPEED), LINEAR_DECEL, MIN_SPEED, self.get_input(HORIZON))
+        v = ramp(remaining, self.get_input(self.SPEED), LINEAR_DECEL, MIN_SPEED)
         w = -HEADING_GAIN * wrap_angle(pose.theta - start.theta)
         self.command(v, w)
         self.feedback_message = f"{remaining:+.2f} m to go"
@@ -151,7 +140,7 @@ class DriveTo(OdometryMotion):
     Y = InputPort("y", float, unit="m", doc="goal y in the odometry frame")
     SPEED = InputPort("speed", float, 0.3, unit="m/s", doc="top speed", minimum=0.01, maximum=1.2)
     TOLERANCE = InputPort("tolerance", float, 0.05, unit="m", doc="goal radius", minimum=0.005)
-    PORTS = (X, Y, SPEED, TOLERANCE, HORIZON, *MOTION_PORTS)
+    PORTS = (X, Y, SPEED, TOLERANCE, *MOTION_PORTS)
     TURN_IN_PLACE = math.radians(30.0)  # heading error above which the robot turns before driving
 
     def step(self, pose: Pose2D) -> Status:
@@ -162,8 +151,8 @@ class DriveTo(OdometryMotion):
             return Status.SUCCESS
         error = wrap_angle(math.atan2(dy, dx) - pose.theta)
         w = ramp(error, math.radians(60.0), ANGULAR_DECEL, 0.0) if error else 0.0
-        v = 0.0 if abs(error) > self.TURN_IN_PLACE else ramp(distance, self.get_input(self.SPEED), LINEAR_DECEL,
-                                                              MIN_SPEED, self.get_input(HORIZON)) * math.cos(error)
+        v = 0.0 if abs(error) > self.TURN_IN_PLACE else ramp(distance, self.get_input(self.SPEED),
+                                                              LINEAR_DECEL, MIN_SPEED) * math.cos(error)
         self.command(v, w)
         self.feedback_message = f"{distance:.2f} m to go"
         return Status.RUNNING

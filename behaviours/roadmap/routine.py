@@ -42,10 +42,6 @@ HEAD_SPEED = 2.0  # rad/s
 MIN_TURN = math.radians(0.3)  # smaller turns are not worth a motion
 MOTION_SLACK = 3.0  # a motion may take this many times its duration at top speed ...
 MOTION_MARGIN = 5.0  # ... plus this (s: accelerating, ramping down) before it counts as stuck
-ARRIVAL_HORIZON = 0.5  # s: drives slow down so their braking distance plus this much travel ends at the goal
-"""The default ``horizon`` of ``AvoidObstacles`` (eq. 1 of docs/obstacles.md): a wrapped routine's drive
-then asks for no room beyond its goal, and a goal near walls (a target in a corner) is reached
-without a detour."""
 
 
 class Failed(Exception):
@@ -186,7 +182,7 @@ class RoutineBehaviour(BearingsBehaviour):
             yield from self._clear_stall()
             self._last_direction = math.copysign(1.0, distance)
         speed = self.get_input(SPEED)
-        node = Drive(name=f"{self.name}: {what}", distance=distance, speed=speed, horizon=ARRIVAL_HORIZON, **bound)
+        node = Drive(name=f"{self.name}: {what}", distance=distance, speed=speed, **bound)
         yield from self.run_motion(node, what, abs(distance) / speed)
 
     def drive_to(self, x: float, y: float, what: str = "driving", tolerance: float = 0.02) -> Step[None]:
@@ -201,8 +197,7 @@ class RoutineBehaviour(BearingsBehaviour):
         pose = yield from self.pose()
         self._last_direction = 1.0
         speed = self.get_input(SPEED)
-        node = DriveTo(name=f"{self.name}: {what}", x=x, y=y, speed=speed, tolerance=tolerance,
-                       horizon=ARRIVAL_HORIZON, **self._bound())
+        node = DriveTo(name=f"{self.name}: {what}", x=x, y=y, speed=speed, tolerance=tolerance, **self._bound())
         turn = abs(wrap_angle(math.atan2(y - pose.y, x - pose.x) - pose.theta))
         yield from self.run_motion(node, what, math.hypot(x - pose.x, y - pose.y) / speed
                                    + math.degrees(turn) / self.get_input(TURN_SPEED))

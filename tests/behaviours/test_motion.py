@@ -7,7 +7,7 @@ import math
 import pytest
 from py_trees.common import Status
 
-from behaviours.motion import Drive, DriveTo, Rotate, Stop, ramp
+from behaviours.motion import Drive, DriveTo, Rotate, Stop
 from behaviours.testing import BehaviourHarness
 from behaviours.wait import Wait
 from drivers.interfaces import STOP, VelocityCommand
@@ -62,30 +62,6 @@ def test_drive_slows_down_before_the_goal():
     harness.tick()
     near = harness.read("/robot/command").v
     assert far == pytest.approx(1.0) and near < math.sqrt(2 * 0.3 * 0.05) + 1e-9
-
-
-def test_a_ramp_with_a_horizon_ends_braking_plus_horizon_travel_at_the_goal():
-    # eq. 1 solved for v: a = 0.25, h = 0.5, d = 0.25: a h = 0.125, sqrt(0.125^2 + 2 0.25 0.25) = 0.375, v = 0.25
-    # (check: braking 0.25^2 / 0.5 = 0.125 m plus 0.25 * 0.5 = 0.125 m of horizon = d)
-    assert ramp(0.25, 0.3, 0.25, 0.02, horizon=0.5) == pytest.approx(0.25)
-    assert ramp(-0.25, 0.3, 0.25, 0.02, horizon=0.5) == pytest.approx(-0.25)  # backwards alike
-    assert ramp(0.25, 0.3, 0.25, 0.02) == pytest.approx(0.3)  # without one: sqrt(2 a d) = 0.354, capped
-    assert ramp(2.0, 0.3, 0.25, 0.02, horizon=0.5) == pytest.approx(0.3)  # far: the top speed
-    assert ramp(0.001, 0.3, 0.25, 0.02, horizon=0.5) == pytest.approx(0.02)  # the floor
-
-
-def test_drive_with_a_horizon_slows_sooner_and_still_arrives():
-    harness = BehaviourHarness(Drive(distance=0.25, speed=0.3, horizon=0.5), blackboard={"/robot/odometry": Pose2D()})
-    harness.tick()
-    assert harness.read("/robot/command").v == pytest.approx(0.25)
-    assert harness.tick_until(between=integrate) == Status.SUCCESS
-    assert harness.read("/robot/odometry").x == pytest.approx(0.25, abs=0.01)
-
-
-def test_drive_to_with_a_horizon_slows_sooner():
-    harness = BehaviourHarness(DriveTo(x=0.25, y=0.0, speed=0.3, horizon=0.5), blackboard={"/robot/odometry": Pose2D()})
-    harness.tick()
-    assert harness.read("/robot/command").v == pytest.approx(0.25)
 
 
 @pytest.mark.parametrize("angle", [90.0, -45.0, 270.0])

@@ -10,10 +10,9 @@ import pytest
 from py_trees.common import Status
 
 from behaviours.ports import OutputPort
-from behaviours.roadmap.routine import ARRIVAL_HORIZON, CAMERA_OFFSET, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.routine import CAMERA_OFFSET, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP, PanTiltState
-from maps.avoidance.sweep import AvoidSettings, needed_distance
 from perception.camera import PinholeCamera
 from perception.frame import Frame
 from perception.geometry import Pose2D
@@ -58,24 +57,6 @@ def test_turns_drives_then_takes_an_image_at_rest():
     frame, at = harness.behaviour.image
     assert at.y == pytest.approx(pose.y)
     assert frame.stamp >= harness.clock.now() - 0.5  # taken after the robot stopped, not before
-
-
-def test_drives_slow_down_so_an_avoidance_asks_for_no_room_beyond_the_goal():
-    """Eq. 1 (maps/avoidance): with the routine's horizon, braking distance plus the horizon's travel
-    of every command of the 0.5 m drive is the distance still to go (0.5 m at first: v = 0.3, capped)."""
-    settings = AvoidSettings(footprint=np.zeros((0, 2)), horizon=ARRIVAL_HORIZON)
-    harness = BehaviourHarness(Errand(), blackboard={"/robot/odometry": Pose2D()})
-    asked: list[tuple[float, float]] = []
-
-    def record(h: BehaviourHarness) -> None:
-        command, pose = h.read("/robot/command"), h.read("/robot/odometry")
-        if command is not None and command.v > 0.02:
-            asked.append((needed_distance(command.v, settings), 0.5 - pose.y))
-        world(h)
-
-    assert harness.tick_until(between=record) == Status.SUCCESS
-    assert asked and all(need <= left + 1e-3 for need, left in asked)  # 1 mm: the turn before ends within 0.5 deg
-    assert any(need == pytest.approx(left, abs=1e-3) for need, left in asked)  # not slower than it must
 
 
 def test_an_image_waits_for_rest_and_settle_time():
