@@ -21,7 +21,8 @@ the robot's odometry. Three phases:
   turn on the spot (which says only which way) does not swing the choice as the robot turns. No
   direction will do: stopped. With ``pass_turns`` a wish to turn on the spot passes in every
   phase: a node that turns by a measured angle (the roadmap's random moves and scans) fails when
-  its turn does not happen.
+  its turn does not happen; such a turn during a detour is the node's, not the detour's, and does
+  not count towards :data:`GOING_ROUND`.
 
 Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
 without a direction, for ``timeout`` seconds (a hold the motion node's ending cut short, a route
