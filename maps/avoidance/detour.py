@@ -21,7 +21,8 @@ the robot's odometry. Three phases:
   turn on the spot (which says only which way) does not swing the choice as the robot turns. No
   direction will do: stopped. With ``pass_turns`` a wish to turn on the spot passes in every
   phase: a node that turns by a measured angle (the roadmap's random moves and scans) fails when
-  its turn does not happen.
+  its turn does not happen; such a turn during a detour is the node's, not the detour's, and does
+  not count towards :data:`GOING_ROUND`.
 
 Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
 without a direction, for ``timeout`` seconds (a hold the motion node's ending cut short, a route
@@ -109,6 +110,7 @@ class _Episode:
     clear_since: float | None = None  # the way clear since (the wish passing again)
     held_since: float | None = None  # on a detour with no direction (or stopped by the monitor) since
     by_monitor: bool = False  # held because the collision monitor stopped a wish the arcs found free
+    child_turning: bool = False  # the last tick passed the node's own turn on the spot (pass_turns)
 
 
 class Avoidance:
@@ -133,6 +135,10 @@ class Avoidance:
         """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
         robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command."""
         if self.settings.pass_turns and v == 0.0 and w != 0.0:  # the monitor judges a turn on the spot
+            episode = self._episode
+            if episode is not None and episode.detour_start is not None:
+                self._travelled(episode, pose)
+                episode.child_turning = True  # its own measured turn is not the detour's: not counted
             return Decision(v, w, self.phase, passed=True)
         around = Surroundings.of(points, self.avoid)
         self._pose = pose
@@ -204,10 +210,8 @@ class Avoidance:
 
     def _detour(self, episode: _Episode, v: float, w: float, around: Surroundings, pose: Pose2D, now: float,
                 stopped: bool) -> Decision:
-        if episode.last is not None:
-            episode.length += math.hypot(pose.x - episode.last.x, pose.y - episode.last.y)
-            episode.turned += wrap_angle(pose.theta - episode.last.theta)
-        episode.last = pose
+        self._travelled(episode, pose)
+        episode.child_turning = False
         if episode.length > self.settings.max_length:
             return self._give_up(f"a detour of {episode.length:.1f} m did not get past the obstacle "
                                  f"(at most {self.settings.max_length:g} m)", now)
@@ -239,6 +243,16 @@ class Avoidance:
                 return self._give_up(self._blocked_reason(now - episode.held_since, v, w, around.points, choice), now)
         episode.side = episode.side or choice.side
         return Decision(*command, "detour", choice)
+
+    @staticmethod
+    def _travelled(episode: _Episode, pose: Pose2D) -> None:
+        """Add the motion since the last tick to the detour's length and turn, unless it was the motion
+        node's own turn on the spot passed with ``pass_turns`` (a homing's measured turns to and from a
+        sidestep would otherwise add up to the 180 degrees that give up)."""
+        if episode.last is not None and not episode.child_turning:
+            episode.length += math.hypot(pose.x - episode.last.x, pose.y - episode.last.y)
+            episode.turned += wrap_angle(pose.theta - episode.last.theta)
+        episode.last = pose
 
     def _held_since(self, pose: Pose2D, now: float) -> float:
         """When a new hold began: now, or when a hold cut short by the node's ending began, if the

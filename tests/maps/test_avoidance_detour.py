@@ -127,6 +127,29 @@ def test_with_pass_turns_a_turn_on_the_spot_passes_while_waiting_and_on_a_detour
     assert not steered.step(0.0, -0.5, PERSON, HERE, 0.2).passed
 
 
+def test_with_pass_turns_the_nodes_own_turns_do_not_count_as_the_detour_turning_round():
+    """On a detour the motion node turns by 100 deg on the spot (passed: a homing facing its target),
+    then the detour turns 100 deg more: the detour itself has turned 100 deg, not 200, and goes on;
+    the same 200 deg all turned on the detour's ticks give up as going round."""
+    a = avoidance(wait=0.0, pass_turns=True)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.1).phase == "detour"
+    t = 0.2
+    for heading in np.radians(np.arange(20.0, 100.1, 20.0)):  # the node's own turn, passed
+        assert a.step(0.0, 0.5, PERSON, Pose2D(0.0, 0.0, float(heading)), t).passed
+        t += 0.1
+    for heading in np.radians(np.arange(100.0, 200.1, 20.0)):  # the detour's ticks
+        assert a.step(0.3, 0.0, PERSON, Pose2D(0.0, 0.0, float(heading)), t).gave_up == ""
+        t += 0.1
+    b = avoidance(wait=0.0)
+    b.step(0.3, 0.0, PERSON, HERE, 0.0)
+    assert b.step(0.3, 0.0, PERSON, HERE, 0.1).phase == "detour"
+    gave_up = ""
+    for i, heading in enumerate(np.radians(np.arange(20.0, 200.1, 20.0))):
+        gave_up = gave_up or b.step(0.3, 0.0, PERSON, Pose2D(0.0, 0.0, float(heading)), 0.2 + 0.1 * i).gave_up
+    assert gave_up.startswith("the detour turned 200 deg")
+
+
 def test_a_detour_that_would_stray_too_far_holds_and_gives_up_saying_so():
     a = avoidance(wait=0.0, timeout=5.0)
     assert a.step(0.3, 0.0, PERSON, HERE, 0.0).phase == "waiting"
