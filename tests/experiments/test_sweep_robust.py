@@ -161,7 +161,8 @@ def test_ctrl_c_keeps_finished_rows_kills_running_episodes_and_resume_runs_the_r
                "--timeout", "600", "--workers", "2", "-o", str(out)]  # only Ctrl-C can end the hanging episode
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
     sweep = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-                             start_new_session=True)  # its own process group, as a terminal job
+                             start_new_session=True,  # its own process group, as a terminal job
+                             preexec_fn=_ctrl_c_live)
     try:
         deadline = time.monotonic() + 30
         while not (out / "results.jsonl").is_file() or not (out / "results.jsonl").read_text().strip():
@@ -178,8 +179,10 @@ def test_ctrl_c_keeps_finished_rows_kills_running_episodes_and_resume_runs_the_r
         try:
             _, err = sweep.communicate(timeout=180)  # a guard against a hang: a loaded machine needs ~25 s
         except subprocess.TimeoutExpired:
+            states = _signal_states([sweep.pid, *sorted(descendants(sweep.pid))])  # which of them held Ctrl-C
             os.killpg(sweep.pid, signal.SIGKILL)
-            pytest.fail(f"the sweep did not end within 180 s of Ctrl-C; it said: {sweep.communicate()[1][-2000:]}")
+            pytest.fail(f"the sweep did not end within 180 s of Ctrl-C; processes: {states}; "
+                        f"it said: {sweep.communicate()[1][-2000:]}")
     finally:
         if sweep.poll() is None:
             os.killpg(sweep.pid, signal.SIGKILL)
@@ -222,3 +225,24 @@ def test_a_server_lost_while_stopping_does_not_start_the_episode_again(tmp_path,
     stop.clear()  # not stopped, time left: the episode gets one more server, as before
     worker._run_forked(_SlowToKill(), ["run", "x"], tmp_path / "log", time.monotonic(), 60.0, stop)
     assert started_again == [1]
+
+
+def _ctrl_c_live() -> None:
+    """SIGINT as a terminal's job has it: a test suite started in the background of a shell without
+    job control inherits SIGINT ignored, and so would the sweep (Python then leaves it ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def _signal_states(pids: list[int]) -> str:
+    """Each process's state and signal masks from /proc (blocked, ignored, caught), for a failure message."""
+    states = []
+    for pid in pids:
+        try:
+            fields = dict(line.split(":", 1) for line in Path(f"/proc/{pid}/status").read_text().splitlines()
+                          if ":" in line)
+            cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ")[:120].decode(errors="replace")
+        except OSError:
+            continue
+        states.append(f"{pid} {fields.get('State', '?').strip()} blk={fields.get('SigBlk', '?').strip()} "
+                      f"ign={fields.get('SigIgn', '?').strip()} cgt={fields.get('SigCgt', '?').strip()} [{cmdline}]")
+    return "; ".join(states)
