@@ -76,3 +76,18 @@ class Pose2D:
     def as_array(self) -> np.ndarray:
         """``[x, y, theta]`` as a float array."""
         return np.array([self.x, self.y, self.theta], dtype=float)
+
+
+def frame_to_parent(frame: Pose2D, xy: np.ndarray) -> np.ndarray:
+    """(x, y) rows (N x 2) given in the frame of the pose ``frame`` (origin there, x ahead, y left),
+    in the frame that pose is given in (a base's points in odometry, a run's start frame in the world)."""
+    c, s = math.cos(frame.theta), math.sin(frame.theta)
+    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    return np.column_stack([frame.x + c * xy[:, 0] - s * xy[:, 1], frame.y + s * xy[:, 0] + c * xy[:, 1]])
+
+
+def parent_to_frame(frame: Pose2D, xy: np.ndarray) -> np.ndarray:
+    """The inverse of :func:`frame_to_parent`: (x, y) rows in the frame of the pose ``frame``."""
+    c, s = math.cos(frame.theta), math.sin(frame.theta)
+    rel = np.asarray(xy, dtype=np.float64).reshape(-1, 2) - (frame.x, frame.y)
+    return np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])

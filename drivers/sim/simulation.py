@@ -38,7 +38,7 @@ from drivers.sim.visualise import RerunLogger
 from drivers.sim.world import load_world
 from drivers.sim.world_values import World, empty_world
 from perception.frame import Frame, LandmarkBearings
-from perception.geometry import Pose2D, wrap_angle
+from perception.geometry import Pose2D, frame_to_parent, parent_to_frame, wrap_angle
 
 CONTACT_PRECISION_M = 0.0005  # m: a blocked step ends this close to where the robot would touch
 
@@ -270,7 +270,7 @@ class Simulation:
 
     def odometry_in_world(self) -> np.ndarray:
         """Where odometry believes the robot is, as world (x, y): odometry starts at the true start."""
-        return start_to_world(_pose_of(self.truth.true[0]), np.asarray(self.truth.odometry[-1:])[:, 1:3])[0]
+        return frame_to_parent(_pose_of(self.truth.true[0]), np.asarray(self.truth.odometry[-1:])[:, 1:3])[0]
 
     def true_trajectory(self) -> np.ndarray:
         """The whole true trajectory as world (x, y) rows."""
@@ -282,7 +282,7 @@ class Simulation:
 
     def odometry_trajectory_in_world(self) -> np.ndarray:
         """The whole odometry trajectory as world (x, y) rows."""
-        return start_to_world(_pose_of(self.truth.true[0]), np.asarray(self.truth.odometry)[:, 1:3])
+        return frame_to_parent(_pose_of(self.truth.true[0]), np.asarray(self.truth.odometry)[:, 1:3])
 
     def ground_truth_report(
         self,
@@ -310,7 +310,7 @@ class Simulation:
         true = np.asarray(self.truth.true, dtype=float)
         xy = true[:, 1:3]
         if frame == "start":  # express the trajectory in the start frame instead
-            xy = world_to_start(_pose_of(true[0]), xy)
+            xy = parent_to_frame(_pose_of(true[0]), xy)
         report: dict = {
             "world": self.name,
             "seed": self.seed,
@@ -399,21 +399,6 @@ def path_distances(trajectory_xy: np.ndarray, reference_xy: np.ndarray) -> np.nd
     t = np.clip(np.sum((p - a) * ab, axis=2) / seg_len2, 0.0, 1.0)
     closest = a + t[..., None] * ab
     return np.linalg.norm(p - closest, axis=2).min(axis=1)
-
-
-def start_to_world(start: Pose2D, xy: np.ndarray) -> np.ndarray:
-    """(x, y) rows (N x 2) given in the frame of the ``start`` pose (origin there, x ahead, y left:
-    the frame odometry counts in from a run's start), in the world frame."""
-    c, s = math.cos(start.theta), math.sin(start.theta)
-    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-    return np.column_stack([start.x + c * xy[:, 0] - s * xy[:, 1], start.y + s * xy[:, 0] + c * xy[:, 1]])
-
-
-def world_to_start(start: Pose2D, xy: np.ndarray) -> np.ndarray:
-    """The inverse of :func:`start_to_world`: world (x, y) rows in the frame of the ``start`` pose."""
-    c, s = math.cos(start.theta), math.sin(start.theta)
-    rel = np.asarray(xy, dtype=np.float64).reshape(-1, 2) - (start.x, start.y)
-    return np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])
 
 
 def _pose_of(row: Sequence[float]) -> Pose2D:

@@ -70,7 +70,6 @@ import cv2
 import numpy as np
 
 from drivers.sim.floor import FloorGrid, reachable_floor
-from drivers.sim.simulation import start_to_world
 from drivers.sim.world import load_world
 from experiments.eval import EvalOptions
 from experiments.eval import people as crowd
@@ -82,7 +81,7 @@ from maps.exploration.codec import unpack_cells
 from maps.exploration.grid import GridFrame
 from maps.exploration.head import StereoHead
 from maps.exploration.integrate import scan_cells
-from perception.geometry import Pose2D, wrap_angle
+from perception.geometry import Pose2D, frame_to_parent, wrap_angle
 
 DESCRIPTION = "explored floor against path length and time: the method, closest frontier, cameras fixed, eq. 1"
 MISSION = "explore"
@@ -240,7 +239,7 @@ def map_in_world(report: dict[str, Any]) -> np.ndarray:
     offsets = np.array([(a, b) for a in sub for b in sub]) * frame.resolution
     local = (frame.centre_of(rows, cols)[:, None, :] + offsets[None, :, :]).reshape(-1, 2)
     _, x0, y0, th0 = report["ground_truth"]["trajectory"][0]
-    return start_to_world(Pose2D(x0, y0, th0), local)
+    return frame_to_parent(Pose2D(x0, y0, th0), local)
 
 
 def pose_errors(report: dict[str, Any]) -> dict[str, Any]:
@@ -255,7 +254,7 @@ def pose_errors(report: dict[str, Any]) -> dict[str, Any]:
 
     def error(t: float, x: float, y: float, theta: float) -> tuple[float, float]:
         truth = trajectory.at(t)
-        world = start_to_world(start, np.array([[x, y]]))[0]
+        world = frame_to_parent(start, np.array([[x, y]]))[0]
         return (math.hypot(world[0] - truth.x, world[1] - truth.y),
                 math.degrees(abs(wrap_angle(theta + start.theta - truth.theta))))
 

@@ -50,11 +50,10 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from drivers.sim.floor import FloorGrid, reachable_floor
-from drivers.sim.simulation import start_to_world, world_to_start
 from drivers.sim.world import World
 from maps.planning import plan_path, segment_is_free
 from maps.room import FreeGrid
-from perception.geometry import Pose2D
+from perception.geometry import Pose2D, frame_to_parent, parent_to_frame
 
 RESOLUTION = 0.05  # m: the floor grid
 REACH = 4.0  # m along the floor: the farthest end of the default tour
@@ -163,7 +162,7 @@ def default_route(world: World) -> Route:
     for margin in MARGINS:
         points = _tour(floor, from_start, start, margin, world.robot_radius)
         if points is not None:
-            return Route(points, world_to_start(start, points[1:]).ravel().tolist(), "tour", margin)
+            return Route(points, parent_to_frame(start, points[1:]).ravel().tolist(), "tour", margin)
     raise ValueError(f"no room for a route: the floor the robot reaches from the start ({start.x:g}, {start.y:g}) "
                      f"goes less than {MIN_END:g} m with {MARGINS[-1]:g} m of clearance; give waypoints with "
                      "--option route=x0,y0,...")
@@ -180,7 +179,7 @@ def back_route(world: World) -> Route:
     t = (stop - along[k - 1]) / max(float(steps[k - 1]), 1e-12)
     end = way[k - 1] + t * (way[k] - way[k - 1])
     points = np.vstack((way, way[-2:k - 1:-1] if k < len(way) - 1 else np.zeros((0, 2)), [end]))
-    return Route(points, world_to_start(world.start, points[1:]).ravel().tolist(), "back", tour.margin_m)
+    return Route(points, parent_to_frame(world.start, points[1:]).ravel().tolist(), "back", tour.margin_m)
 
 
 def _tour(floor: Floor, from_start: np.ndarray, start: Pose2D, margin: float, radius: float) -> np.ndarray | None:
@@ -248,7 +247,7 @@ def given_route(world: World, odometry: Sequence[float]) -> Route:
     """Waypoints in the start's odometry frame, checked on the floor; ``ValueError`` naming the
     first waypoint or leg off the reachable floor."""
     start = world.start
-    points = np.vstack(([[start.x, start.y]], start_to_world(start, np.asarray(odometry, dtype=np.float64))))
+    points = np.vstack(([[start.x, start.y]], frame_to_parent(start, np.asarray(odometry, dtype=np.float64))))
     lo, hi = points.min(axis=0) - ROUTE_WINDOW_MARGIN, points.max(axis=0) + ROUTE_WINDOW_MARGIN
     floor = Floor.around(world, (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])))
     for k, (a, b) in enumerate(zip(points[:-1], points[1:], strict=True)):

@@ -10,28 +10,13 @@ people leave a short trail of old echoes behind them: ``keep`` is the price of t
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from perception.geometry import Pose2D
+from perception.geometry import Pose2D, frame_to_parent, parent_to_frame
 
 RESOLUTION = 0.01  # m: remembered points closer than this are one
-
-
-def to_odometry(points: np.ndarray, pose: Pose2D) -> np.ndarray:
-    """Base-frame points (N x 2) in the odometry frame, the base at ``pose``."""
-    c, s = math.cos(pose.theta), math.sin(pose.theta)
-    pts = np.asarray(points, dtype=float).reshape(-1, 2)
-    return np.column_stack((pose.x + c * pts[:, 0] - s * pts[:, 1], pose.y + s * pts[:, 0] + c * pts[:, 1]))
-
-
-def to_base(points: np.ndarray, pose: Pose2D) -> np.ndarray:
-    """Odometry-frame points (N x 2) in the base frame of ``pose``."""
-    c, s = math.cos(pose.theta), math.sin(pose.theta)
-    d = np.asarray(points, dtype=float).reshape(-1, 2) - np.array([pose.x, pose.y])
-    return np.column_stack((c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]))
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,7 +33,7 @@ class ObstacleMemory:
         if self.stamps and stamp == self.stamps[-1]:
             return self
         kept = [(t, p) for t, p in zip(self.stamps, self.scans, strict=True) if t > stamp - self.keep]
-        kept.append((stamp, to_odometry(points, pose)))
+        kept.append((stamp, frame_to_parent(pose, points)))
         return ObstacleMemory(self.keep, tuple(t for t, _ in kept), tuple(p for _, p in kept))
 
     def around(self, pose: Pose2D, now: float) -> np.ndarray:
@@ -58,4 +43,4 @@ class ObstacleMemory:
             return np.zeros((0, 2))
         points = np.vstack(recent)  # a transducer's reading repeats until it fires again: keep one of each
         _, first = np.unique(np.round(points / RESOLUTION).astype(np.int64), axis=0, return_index=True)
-        return to_base(points[np.sort(first)], pose)
+        return parent_to_frame(pose, points[np.sort(first)])

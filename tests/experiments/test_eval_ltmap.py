@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from drivers.sim.simulation import path_distances, start_to_world
+from drivers.sim.simulation import path_distances
 from drivers.sim.world import load_world
 from experiments.eval import AREAS
 from experiments.eval.ltmap import (
@@ -28,6 +28,7 @@ from experiments.eval.ltmap import (
 from experiments.eval.ltmap_route import MARGINS, MIN_END, Floor, default_route, parse_route
 from experiments.sweep import Episode
 from missions.cli import main
+from perception.geometry import frame_to_parent
 
 # A 6 x 4 m room with a box and a pillar, landmarks on the walls and the furniture, the robot
 # starting in a corner facing the room's far end.
@@ -57,7 +58,7 @@ def test_the_default_route_is_a_bent_tour_of_the_free_floor(world_file):
     assert route.source == "tour" and route.margin_m in MARGINS
     assert route.world_xy[0].tolist() == [start.x, start.y]
     odometry = np.reshape(route.odometry, (-1, 2))
-    np.testing.assert_allclose(start_to_world(start, odometry), route.world_xy[1:], atol=1e-9)
+    np.testing.assert_allclose(frame_to_parent(start, odometry), route.world_xy[1:], atol=1e-9)
     floor = Floor.around(world, (-1.0, -1.0, 7.0, 5.0))
     legs = zip(route.world_xy[:-1], route.world_xy[1:], strict=True)
     along = np.concatenate([np.linspace(a, b, 50) for a, b in legs])
@@ -109,7 +110,7 @@ def test_the_route_back_retraces_the_tour_and_ends_a_third_of_the_way_out(world_
     assert along[-1] == pytest.approx(2.0 / 3.0 * tour.length_m) and back.length_m == pytest.approx(
         5.0 / 3.0 * tour.length_m)
     assert np.all(path_distances(returned, tour.world_xy) < 1e-9)  # every point of the way back on the tour
-    np.testing.assert_allclose(start_to_world(world.start, np.reshape(back.odometry, (-1, 2))), back.world_xy[1:],
+    np.testing.assert_allclose(frame_to_parent(world.start, np.reshape(back.odometry, (-1, 2))), back.world_xy[1:],
                                atol=1e-9)
 
 

@@ -7,16 +7,16 @@ import math
 import numpy as np
 import pytest
 
-from maps.avoidance.memory import ObstacleMemory, to_base, to_odometry
-from perception.geometry import Pose2D
+from maps.avoidance.memory import ObstacleMemory
+from perception.geometry import Pose2D, frame_to_parent, parent_to_frame
 
 
 def test_points_go_to_the_odometry_frame_and_back():
     pose = Pose2D(1.0, 2.0, math.pi / 2)
     # 1 m ahead of a base facing +y at (1, 2) is (1, 3)
-    assert to_odometry(np.array([[1.0, 0.0]]), pose) == pytest.approx(np.array([[1.0, 3.0]]))
+    assert frame_to_parent(pose, np.array([[1.0, 0.0]])) == pytest.approx(np.array([[1.0, 3.0]]))
     points = np.array([[0.3, -0.2], [2.0, 1.0]])
-    assert to_base(to_odometry(points, pose), pose) == pytest.approx(points)
+    assert parent_to_frame(pose, frame_to_parent(pose, points)) == pytest.approx(points)
 
 
 def test_a_remembered_point_stays_where_it_was_as_the_robot_moves():

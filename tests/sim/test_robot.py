@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from drivers.interfaces import Base, PanTilt
-from drivers.sim.simulation import start_to_world, world_to_start
-from perception.geometry import Pose2D
+from perception.geometry import Pose2D, frame_to_parent, parent_to_frame
 
 ROOM = """
 start: {x: 1.0, y: 1.0, theta_deg: 0}
@@ -144,9 +143,9 @@ def test_ground_truth_report_measures_goal_and_path_errors_in_world_or_start_fra
 def test_the_start_frame_is_the_start_pose_turned_and_moved() -> None:
     """From the start (1, 2) facing +y (90 deg): 1 m ahead is world (1, 3), 1 m left is world (0, 2)."""
     start = Pose2D(1.0, 2.0, math.pi / 2)
-    world = start_to_world(start, np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]))
+    world = frame_to_parent(start, np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]))
     assert world == pytest.approx(np.array([[1.0, 3.0], [0.0, 2.0], [1.0, 2.0]]), abs=1e-12)
-    assert world_to_start(start, world) == pytest.approx(np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]), abs=1e-12)
+    assert parent_to_frame(start, world) == pytest.approx(np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]), abs=1e-12)
 
 
 def test_a_long_step_cannot_jump_over_a_thin_wall(sim_from) -> None:
