@@ -18,6 +18,7 @@ from typing import Any
 
 from experiments.eval import AREAS, EvalOptions
 from experiments.sweep import SweepError, SweepInputError, SweepInterrupted, executor_for
+from experiments.sweep.episode import parse_seeds
 from experiments.sweep.lifeline import lifeline
 from experiments.sweep.sweeper import cap_workers, prepare_results_folder, progress_stream
 from experiments.sweep.table import TABLE
@@ -41,7 +42,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("area", choices=sorted(AREAS), help="what to evaluate")
     parser.add_argument("--world", required=True, metavar="NAME|PATH", help="a shipped world or a world file")
-    parser.add_argument("--seeds", type=int, default=1, metavar="N", help="seeds 0 to N-1 (default 1)")
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument("--seeds", type=int, default=1, metavar="N", help="seeds 0 to N-1 (default 1)")
+    which.add_argument("--seed-list", metavar="SPEC",
+                       help="these seeds instead: 7, 2-4 or 0,3,5-6 (e.g. one seed that failed, alone)")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the cores here)")
     where.add_argument("--cluster", metavar="ADDRESS", help="run the episodes on this Dask scheduler")
@@ -97,6 +101,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         world = module.check_world(args.world)
         extra = area_options(module, args.area, args.option)
+        seeds = parse_seeds(args.seed_list, option="--seed-list") if args.seed_list else list(range(args.seeds))
         settings = module.check_options(args.world, extra) if hasattr(module, "check_options") else None
         if args.output is not None:
             prepare_results_folder(args.output)
@@ -109,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
         folder = args.output or Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="bearings-eval-")))
         try:
             executor = stack.enter_context(executor_for(cap_workers(args.workers, "eval"), args.cluster))
-            options = EvalOptions(args.world, list(range(args.seeds)), executor, folder, args.timeout,
+            options = EvalOptions(args.world, seeds, executor, folder, args.timeout,
                                   args.max_time, progress_stream(args.progress), extra, (world, settings))
             figures = module.run(options, resume=args.resume)
         except SweepInputError as exc:

@@ -136,24 +136,24 @@ def grid(
 # Command-line specs
 
 
-def parse_seeds(spec: str) -> list[int]:
+def parse_seeds(spec: str, *, option: str = "--seeds") -> list[int]:
     """``0-99``, ``7``, ``0-3,10,20-22`` to a sorted list of distinct seeds (inclusive ranges)."""
     seeds: set[int] = set()
     for part in spec.split(","):
         text = part.strip()
         match = re.fullmatch(r"(\d+)(?:-(\d+))?", text)
         if match and max(len(n or "") for n in match.groups()) > len(str(MAX_SEED)):
-            raise SweepInputError(f"--seeds: seeds go from 0 to {MAX_SEED}, got {describe_value(text)}")
+            raise SweepInputError(f"{option}: seeds go from 0 to {MAX_SEED}, got {describe_value(text)}")
         if not match:
-            raise SweepInputError(f"--seeds {spec}: expected N, A-B or a comma-separated list of them, got {text!r}")
+            raise SweepInputError(f"{option} {spec}: expected N, A-B or a comma-separated list of them, got {text!r}")
         first = int(match.group(1))
         last = int(match.group(2)) if match.group(2) is not None else first
         if last < first:
-            raise SweepInputError(f"--seeds {spec}: the range {text} is empty (write it as {last}-{first})")
+            raise SweepInputError(f"{option} {spec}: the range {text} is empty (write it as {last}-{first})")
         if last > MAX_SEED:
-            raise SweepInputError(f"--seeds {spec}: seeds go from 0 to {MAX_SEED}")
+            raise SweepInputError(f"{option} {spec}: seeds go from 0 to {MAX_SEED}")
         if last - first >= MAX_EPISODES:
-            raise SweepInputError(f"--seeds {spec}: more than {MAX_EPISODES} seeds")
+            raise SweepInputError(f"{option} {spec}: more than {MAX_EPISODES} seeds")
         seeds.update(range(first, last + 1))
     return sorted(seeds)
 

@@ -161,6 +161,16 @@ def test_the_command_runs_the_episodes_through_the_sweep_runner(tmp_path, capsys
     assert len(figures["runs"]) == 4 and (tmp_path / "out" / "results.jsonl").exists()
 
 
+def test_a_seed_list_runs_those_seeds_alone(tmp_path, capsys):
+    code = main(["eval", "exploration", "--world", BOX, "--seed-list", "3", "--workers", "1", "--max-time", "1",
+                 "--option", "variants=method", "-o", str(tmp_path / "out"), "--json"])
+    assert code == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert figures["seeds"] == 1 and [run["seed"] for run in figures["runs"]] == [3]
+    assert main(["eval", "exploration", "--world", BOX, "--seed-list", "3-1"]) == 2
+    assert "--seed-list 3-1" in capsys.readouterr().err
+
+
 def test_episodes_that_all_fail_are_counted_not_a_crash(tmp_path, capsys):
     code = main(["eval", "exploration", "--world", BOX, "--seeds", "1", "--workers", "1", "--timeout", "0.01",
                  "-o", str(tmp_path / "out"), "--json"])
