@@ -37,6 +37,12 @@ OPENCV_MODEL = "bearings_opencv"
 _CATADIOPTRIC_FIELDS = ("cx", "cy", "r_inner", "r_outer", "elev_inner", "elev_outer", "azimuth_offset")
 _RAW_ENCODINGS = {"mono8": 1, "8uc1": 1, "bgr8": 3, "8uc3": 3, "rgb8": 3, "bgra8": 4, "rgba8": 4, "8uc4": 4}
 _FLOAT64, _FLOAT32, _INT32, _UINT32 = 8, 7, 5, 6  # sensor_msgs/PointField datatypes
+MAX_DECODED_PIXELS = 50_000_000
+"""The largest compressed image a log may hold (a 50-megapixel camera; 150 MB as BGR): JPEG and PNG
+compress a plain image a thousandfold, so a hostile message of a few kB could otherwise ask OpenCV for
+gigabytes (its own limit is 2^30 pixels, over 3 GB)."""
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+_JPEG_FRAME_MARKERS = frozenset(range(0xC0, 0xD0)) - {0xC4, 0xC8, 0xCC}  # SOF0-SOF15 (not DHT, JPG, DAC)
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,13 +86,43 @@ def image_from_compressed(message: Mapping[str, Any]) -> np.ndarray:
     declared = str(message.get("format", "")).lower()
     if not any(name in declared for name in ("jpeg", "jpg", "png")):
         raise ValueError(f"compressed image format {declared!r} is not one we read (jpeg, png)")
-    data = np.frombuffer(bytes(message["data"]), dtype=np.uint8)
+    raw = bytes(message["data"])
+    size = compressed_image_size(raw)
+    if size is not None and size[0] * size[1] > MAX_DECODED_PIXELS:
+        raise ValueError(f"the {declared} image declares {size[0]}x{size[1]} pixels "
+                         f"(at most {MAX_DECODED_PIXELS / 1e6:.0f} megapixels are decoded)")
+    data = np.frombuffer(raw, dtype=np.uint8)
     image = cv2.imdecode(data, cv2.IMREAD_UNCHANGED) if data.size else None
     if image is None or image.dtype != np.uint8:
         raise ValueError(f"the {declared} image data ({data.size} bytes) does not decode to an 8-bit image")
     if image.ndim == 3 and image.shape[2] == 4:
         image = cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
     return image
+
+
+def compressed_image_size(data: bytes) -> tuple[int, int] | None:
+    """(width, height) from a PNG's IHDR or a JPEG's frame header, read before anything is decoded;
+    None when neither is found (OpenCV then refuses the data itself). OpenCV's Python API offers no
+    header-only read, hence these few bytes of the two formats' public specifications."""
+    if data[:8] == _PNG_SIGNATURE and len(data) >= 24 and data[12:16] == b"IHDR":
+        return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+    at = 2 if data[:2] == b"\xff\xd8" else len(data)
+    while at + 4 <= len(data):
+        if data[at] != 0xFF:
+            return None
+        marker = data[at + 1]
+        if marker == 0xFF:  # fill byte
+            at += 1
+            continue
+        if marker in _JPEG_FRAME_MARKERS:
+            if at + 9 > len(data):
+                return None
+            return int.from_bytes(data[at + 7:at + 9], "big"), int.from_bytes(data[at + 5:at + 7], "big")
+        if marker == 0xD8 or 0xD0 <= marker <= 0xD7:  # standalone markers carry no length
+            at += 2
+            continue
+        at += 2 + int.from_bytes(data[at + 2:at + 4], "big")
+    return None
 
 
 def image_from_raw(message: Mapping[str, Any]) -> np.ndarray:

@@ -56,6 +56,33 @@ def test_an_image_we_cannot_write_or_read_is_a_value_error_naming_it():
         cc.image_from_raw({"encoding": "mono8", "height": 2, "width": 3, "step": 3, "data": b"\x00" * 4})
 
 
+def test_the_declared_size_is_read_from_the_header_by_hand():
+    # a JPEG: SOI, an APP0 segment of length 4 (2 bytes of payload), a fill byte, then SOF2 (progressive):
+    # length 17, precision 8, height 0x0102 = 258, width 0x0304 = 772
+    jpeg = b"\xff\xd8" + b"\xff\xe0\x00\x04ab" + b"\xff" + b"\xff\xc2\x00\x11\x08\x01\x02\x03\x04" + b"\x00" * 12
+    assert cc.compressed_image_size(jpeg) == (772, 258)
+    # DHT (0xC4) is not a frame header: its bytes are skipped by its length
+    assert cc.compressed_image_size(b"\xff\xd8\xff\xc4\x00\x03x" + jpeg[2:]) == (772, 258)
+    png = b"\x89PNG\r\n\x1a\n" + b"\x00\x00\x00\x0dIHDR" + (640).to_bytes(4, "big") + (480).to_bytes(4, "big")
+    assert cc.compressed_image_size(png) == (640, 480)
+    assert cc.compressed_image_size(b"not an image") is None
+    ok, data = cv2.imencode(".jpg", COLOUR)
+    assert ok and cc.compressed_image_size(data.tobytes()) == (64, 48)  # OpenCV's own JPEG agrees
+
+
+@pytest.mark.parametrize("ext", [".jpg", ".png"])
+def test_a_small_message_declaring_a_huge_image_is_refused_before_decoding(ext):
+    ok, data = cv2.imencode(ext, GREY)
+    raw = bytearray(data.tobytes())
+    if ext == ".png":
+        raw[16:24] = (30_000).to_bytes(4, "big") * 2
+    else:
+        at = next(i for i in range(2, len(raw) - 1) if raw[i] == 0xFF and raw[i + 1] in (0xC0, 0xC2))
+        raw[at + 5:at + 9] = (30_000).to_bytes(2, "big") * 2
+    with pytest.raises(ValueError, match="declares 30000x30000 pixels"):
+        cc.image_from_compressed({"format": ext[1:], "data": bytes(raw)})
+
+
 def test_raw_images_in_every_eight_bit_encoding_come_back_as_grey_or_bgr():
     padded = np.zeros((48, 70), np.uint8)  # rows padded to a step of 70 bytes
     padded[:, :64] = GREY
