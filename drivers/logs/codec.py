@@ -26,6 +26,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+from scipy.spatial.transform import Rotation
+
 from drivers.interfaces import PanTiltCommand, PanTiltState, VelocityCommand
 from perception.geometry import Pose2D, wrap_angle
 from perception.ranges import Bumper, RangeScan, RangeSensor
@@ -182,17 +185,52 @@ class Mounting:
     heading: float
 
 
-def mountings_from(message: Mapping[str, Any], base_frames: Sequence[str] = (BASE_FRAME, "base_footprint")
-                   ) -> dict[str, Mounting]:
-    """The frames a ``tf2_msgs/TFMessage`` places directly on the base, by name."""
+@dataclass(frozen=True, slots=True)
+class StaticTransform:
+    """One ``/tf_static`` transform: where a child frame sits in its parent (metres; quaternion x, y, z, w)."""
+
+    parent: str
+    translation: tuple[float, float, float]
+    rotation: tuple[float, float, float, float]
+
+
+def static_transforms(message: Mapping[str, Any]) -> dict[str, StaticTransform]:
+    """The transforms of a ``tf2_msgs/TFMessage``, by child frame (leading slashes dropped)."""
     out = {}
     for transform in message.get("transforms", []):
-        if str(transform["header"]["frame_id"]).lstrip("/") not in base_frames:
-            continue
-        t = transform["transform"]
-        out[str(transform["child_frame_id"]).lstrip("/")] = Mounting(
-            float(t["translation"]["x"]), float(t["translation"]["y"]), quaternion_yaw(t["rotation"]))
+        t, q = transform["transform"]["translation"], transform["transform"]["rotation"]
+        out[str(transform["child_frame_id"]).lstrip("/")] = StaticTransform(
+            str(transform["header"]["frame_id"]).lstrip("/"), (float(t["x"]), float(t["y"]), float(t.get("z", 0.0))),
+            (float(q["x"]), float(q["y"]), float(q["z"]), float(q["w"])))
     return out
+
+
+def mountings_on_base(transforms: Mapping[str, StaticTransform],
+                      base_frames: Sequence[str] = (BASE_FRAME, "base_footprint")) -> dict[str, Mounting]:
+    """Where each frame sits on the base, following chains of transforms (a camera mast, a sonar
+    board) up to a base frame; a frame whose chain ends elsewhere or loops is not on the base. The
+    heading is that of the frame's x axis seen from above."""
+    out = {}
+    for frame in transforms:
+        chain, parent = [], frame
+        while parent not in base_frames and parent in transforms and len(chain) <= len(transforms):
+            chain.append(transforms[parent])
+            parent = transforms[parent].parent
+        if parent not in base_frames:
+            continue
+        position, rotation = np.zeros(3), Rotation.identity()
+        for step in chain:  # from the frame up: p_parent = R p_child + t
+            position = Rotation.from_quat(step.rotation).apply(position) + step.translation
+            rotation = Rotation.from_quat(step.rotation) * rotation
+        axis = rotation.apply([1.0, 0.0, 0.0])
+        out[frame] = Mounting(float(position[0]), float(position[1]), math.atan2(axis[1], axis[0]))
+    return out
+
+
+def mountings_from(message: Mapping[str, Any], base_frames: Sequence[str] = (BASE_FRAME, "base_footprint")
+                   ) -> dict[str, Mounting]:
+    """The frames one ``tf2_msgs/TFMessage`` places on the base, by name (chains within it followed)."""
+    return mountings_on_base(static_transforms(message), base_frames)
 
 
 def range_messages(scan: RangeScan) -> list[dict[str, Any]]:

@@ -135,6 +135,7 @@ class ReplayRanges:
 
     def __init__(self, replay: Replay) -> None:
         self._replay = replay
+        self._transforms: dict[str, codec.StaticTransform] = {}  # every /tf_static message's, newest wins
         self._mountings: dict[str, codec.Mounting] = {}
         self._ranges: dict[str, tuple[RangeSensor, float]] = {}
         self._bumpers: dict[str, bool] = {}
@@ -142,7 +143,8 @@ class ReplayRanges:
         self._scan: RangeScan | None = None
 
     def on_mounting(self, message: LogMessage) -> None:
-        self._mountings.update(codec.mountings_from(message.message))
+        self._transforms.update(codec.static_transforms(message.message))
+        self._mountings = codec.mountings_on_base(self._transforms)
         for frame in self._mountings:
             if _RANGE_FRAME.match(frame) and frame not in self._ranges:
                 self._ranges[frame] = (_sensor(self._mountings[frame], None), float("nan"))

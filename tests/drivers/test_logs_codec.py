@@ -127,6 +127,33 @@ def test_where_the_sensors_sit_comes_back_from_tf_static():
     assert sensor == RangeSensor(0.0, 0.1, pytest.approx(math.pi / 2), fov=0.3, max_range=3.0, min_range=0.2)
 
 
+def _tf(parent, child, x=0.0, y=0.0, z=0.0, rotation=None):
+    rotation = rotation or codec.yaw_quaternion(0.0)
+    return {"header": {"frame_id": parent}, "child_frame_id": child,
+            "transform": {"translation": {"x": x, "y": y, "z": z}, "rotation": rotation}}
+
+
+def test_chains_of_static_transforms_are_followed_to_the_base():
+    # base_link -> mast (0.1, 0, 0.5) turned 90 deg -> board (0.2, 0, 0) -> range_00 (0, 0.05) turned -45 deg:
+    # the board sits 0.2 m along the mast's x axis, i.e. at (0.1, 0.2) on the base, heading 90 deg;
+    # the sensor 0.05 m along the board's y axis (the base's -x): (0.05, 0.2), heading 90 - 45 = 45 deg
+    message = {"transforms": [
+        _tf("range_board", "range_00", y=0.05, rotation=codec.yaw_quaternion(-math.pi / 4)),
+        _tf("base_link", "mast", x=0.1, z=0.5, rotation=codec.yaw_quaternion(math.pi / 2)),
+        _tf("mast", "range_board", x=0.2),
+        _tf("map", "odom", x=3.0),                       # a chain that ends elsewhere is not on the base
+        _tf("loop_a", "loop_b"), _tf("loop_b", "loop_a"),  # nor is one that loops
+    ]}
+    mountings = codec.mountings_from(message)
+    assert set(mountings) == {"range_00", "mast", "range_board"}
+    sensor = mountings["range_00"]
+    assert (sensor.x, sensor.y, sensor.heading) == pytest.approx((0.05, 0.2, math.pi / 4))
+    # a sensor pitched 30 deg down keeps its heading seen from above
+    pitched = {"x": 0.0, "y": math.sin(math.radians(15)), "z": 0.0, "w": math.cos(math.radians(15))}
+    tilted = codec.mountings_from({"transforms": [_tf("mast", "range_01", rotation=pitched), message["transforms"][1]]})
+    assert tilted["range_01"].heading == pytest.approx(math.pi / 2)
+
+
 def test_transforms_from_another_parent_are_not_mountings():
     transform = {"translation": {"x": 1.0, "y": 0.0}, "rotation": codec.yaw_quaternion(0)}
     message = {"transforms": [{"header": {"frame_id": "map"}, "child_frame_id": "odom", "transform": transform}]}

@@ -145,6 +145,22 @@ def test_a_range_without_a_mounting_is_a_located_error(tmp_path):
         replay.clock()
 
 
+def test_a_sensor_on_a_chain_of_frames_sent_in_two_messages_sits_where_the_chain_puts_it(tmp_path):
+    def tf(parent, child, x, yaw):
+        return {"header": codec.header(0.0, parent), "child_frame_id": child,
+                "transform": {"translation": {"x": x, "y": 0.0, "z": 0.0}, "rotation": codec.yaw_quaternion(yaw)}}
+
+    range_message = {"header": codec.header(0.0, "range_00"), "field_of_view": 0.3, "min_range": 0.1,
+                     "max_range": 3.0, "range": 1.0}
+    rows = [(topics.TF_STATIC, msg.TF, {"transforms": [tf("sonar_board", "range_00", 0.1, 0.0)]}, 0.0),
+            (topics.TF_STATIC, msg.TF, {"transforms": [tf("base_link", "sonar_board", 0.2, math.pi)]}, 0.0),
+            (topics.RANGES, msg.RANGE, range_message, 0.0)]
+    replay = replay_of(write_log(tmp_path / "run.mcap", rows))
+    replay.clock()
+    sensor = replay.robot.ranges.read().sensors[0]  # 0.1 m ahead of a board that faces back from x = 0.2
+    assert (sensor.x, sensor.y, sensor.heading) == pytest.approx((0.1, 0.0, math.pi))
+
+
 def test_a_log_cut_short_replays_up_to_the_cut(tmp_path):
     rows = [(topics.ODOMETRY, msg.ODOMETRY, codec.odometry_message(Pose2D(0.01 * i, stamp=0.1 * i)), 0.1 * i)
             for i in range(300)]
