@@ -212,7 +212,8 @@ def mountings_on_base(transforms: Mapping[str, StaticTransform],
     heading is that of the frame's x axis seen from above."""
     out = {}
     for frame in transforms:
-        chain, parent = [], frame
+        chain: list[StaticTransform] = []
+        parent = frame
         while parent not in base_frames and parent in transforms and len(chain) <= len(transforms):
             chain.append(transforms[parent])
             parent = transforms[parent].parent
