@@ -131,7 +131,8 @@ class AvoidObstacles(BearingsDecorator):
             self.memory = self.memory.added(scan.points(), pose, scan.stamp)
         safety = self.get_input(self.SAFETY, None)
         stopped = safety is not None and safety.state == "stopped"
-        decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped)
+        decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped,
+                                       reach=wish.reach)
         self._record(decision, pose)
         if decision.gave_up:
             self.feedback_message = decision.gave_up

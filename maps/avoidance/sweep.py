@@ -83,17 +83,19 @@ class Surroundings:
     grown: np.ndarray
     near: np.ndarray
     turn_limits: tuple[float, float] = (math.inf, math.inf)  # rad the footprint turns right, left before a touch
+    margin: float = 0.0  # m the footprint was grown by
 
     @classmethod
     def of(cls, points: np.ndarray, settings: AvoidSettings) -> Surroundings:
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         gaps = distance(settings.footprint, pts)
-        grown = grow(settings.footprint, margin(settings.footprint, pts, settings.clearance))
+        kept = margin(settings.footprint, pts, settings.clearance)
+        grown = grow(settings.footprint, kept)
         limits = (math.inf, math.inf)
         if len(pts):  # at 1 rad/s the contact time is the angle
             limits = (float(contact_times(settings.footprint, pts, 0.0, -1.0).min()),
                       float(contact_times(settings.footprint, pts, 0.0, 1.0).min()))
-        return cls(settings.footprint, pts, grown, pts[gaps < settings.clearance], limits)
+        return cls(settings.footprint, pts, grown, pts[gaps < settings.clearance], limits, kept)
 
     def free(self, v: float, w: float) -> float:
         """Metres the grown footprint goes along the arc ``(v, w)`` before it touches a point."""
@@ -105,9 +107,15 @@ class Surroundings:
         command, however far off the point is along the arc."""
         return len(self.near) > 0 and free_distance(self.footprint, self.near, v, w) <= SWEEP_LENGTH
 
-    def open(self, v: float, w: float, needed: float) -> bool:
-        """Is the arc free for ``needed`` metres, grazing nothing?"""
-        return self.free(v, w) >= needed and not self.grazes(v, w)
+    def open(self, v: float, w: float, needed: float, goal: float = math.inf) -> bool:
+        """Is the arc free for ``needed`` metres, grazing nothing? With a ``goal`` metres on, where the
+        motion ends, no farther: the footprint must not touch a point before the goal, and grown by
+        the margin it must be free up to the margin short of it, so the clearance is kept along the
+        way and the goal itself may lie nearer a point than that (a target taken beside a desk)."""
+        if needed <= goal - self.margin:
+            return self.free(v, w) >= needed and not self.grazes(v, w)
+        return (free_distance(self.footprint, self.points, v, w) >= min(needed, goal)
+                and self.free(v, w) >= goal - self.margin and not self.grazes(v, w))
 
     def free_towards(self, psis: np.ndarray) -> np.ndarray:
         """Metres the grown footprint goes straight in each direction ``psis`` (rad from the heading,
