@@ -6,7 +6,8 @@ child wrote (``child_command``: ``/robot/command`` unless remapped) against the 
 (``/robot/ranges``), the odometry and the collision monitor's verdict on the last command
 (``/robot/safety``). It writes the command that gets around (``command``):
 
-- the child's own, while its arc is free for as far as it means to go;
+- the child's own, while its arc is free for as far as it means to go (no farther than the
+  child's goal, when its command says how far that is: ``VelocityCommand.reach``);
 - a stop while the way is blocked, for ``wait`` seconds, so a person walking across can pass;
 - then a detour: of a histogram of directions, the free one closest to where the child heads, on
   one side of the obstacle, kept within ``max_stray`` of the line the robot was on (odometry),

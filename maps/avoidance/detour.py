@@ -5,8 +5,9 @@ base gets instead, from the obstacle points around the base (:mod:`maps.avoidanc
 the robot's odometry. Three phases:
 
 - **clear**: the wish passes unchanged. A forward wish whose arc is not free for as far as it
-  means to go (:func:`maps.avoidance.sweep.needed_distance`), or one the collision monitor
-  stopped, holds the robot: it waits.
+  means to go (:func:`maps.avoidance.sweep.needed_distance`, but no farther than the node's goal
+  when the wish says where that is: ``reach``), or one the collision monitor stopped, holds the
+  robot: it waits.
 - **waiting**: stopped, so that a person walking across can pass (a blocked way that changes by
   itself costs no detour). The way clearing ends the wait; a way blocked again within
   ``clear_time`` resumes the same wait (the clock keeps running). After ``wait`` seconds still

@@ -5,7 +5,9 @@ Given obstacle points around the base (sonar echoes, base frame), this module sa
 - how far a motion node commanding ``(v, w)`` means to go at least: its braking distance plus
   ``v`` times a short ``horizon`` (eq. 1, :func:`needed_distance`). A node that ramps its speed
   down as ``sqrt(2 a d)`` before its goal (``behaviours.motion.ramp``) asks, with ``decel`` equal
-  to ``a``, for ``d`` plus the horizon's travel: an obstacle beyond its goal does not block it;
+  to ``a``, for ``d`` plus the horizon's travel; a node that says where its goal is (the
+  command's ``reach``) is judged no farther (:meth:`Surroundings.open` with ``goal``): an
+  obstacle beyond its goal does not block it;
 - how far the footprint, grown by a margin, travels along the arc ``(v, w)`` before it touches a
   point (:meth:`Surroundings.free`: the exact sweep of
   :func:`perception.arc_sweep.contact_times`, times the speed), and how far straight in a
