@@ -113,11 +113,13 @@ class Surroundings:
         """Is the arc free for ``needed`` metres, grazing nothing? With a ``goal`` metres on, where the
         motion ends, no farther: the footprint must not touch a point before the goal, and grown by
         the margin it must be free up to the margin short of it, so the clearance is kept along the
-        way and the goal itself may lie nearer a point than that (a target taken beside a desk)."""
+        way and the goal itself may lie nearer a point than that (a target taken beside a desk); a
+        point beyond the goal counts for nothing, not even within the clearance (the monitor's stop,
+        should it come, holds the motion all the same)."""
         if needed <= goal - self.margin:
             return self.free(v, w) >= needed and not self.grazes(v, w)
-        return (free_distance(self.footprint, self.points, v, w) >= min(needed, goal)
-                and self.free(v, w) >= goal - self.margin and not self.grazes(v, w))
+        return free_distance(self.footprint, self.points, v, w) >= min(needed, goal) and \
+            self.free(v, w) >= goal - self.margin
 
     def free_towards(self, psis: np.ndarray) -> np.ndarray:
         """Metres the grown footprint goes straight in each direction ``psis`` (rad from the heading,

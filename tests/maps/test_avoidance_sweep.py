@@ -113,3 +113,11 @@ def test_up_to_a_goal_the_footprint_must_not_touch_and_keeps_the_clearance_but_f
     assert beside.margin == pytest.approx(0.1)
     assert beside.open(0.3, 0.0, 0.33, goal=0.35)
     assert not beside.open(0.3, 0.0, 0.33, goal=0.45)
+
+
+def test_a_point_within_the_clearance_beyond_the_goal_does_not_block_it():
+    # 0.08 m ahead of the square's front edge: within the clearance, the margin is half of it, 0.04 m
+    near = around((0.28, 0.0))
+    assert near.margin == pytest.approx(0.04) and not near.open(0.02, 0.0, 0.01)  # grazed within the sweep
+    assert near.open(0.02, 0.0, 0.01, goal=0.05)  # the motion ends 0.03 m short of it
+    assert not near.open(0.02, 0.0, 0.01, goal=0.1)  # ... or touches it first
