@@ -6,7 +6,8 @@ child wrote (``child_command``: ``/robot/command`` unless remapped) against the 
 (``/robot/ranges``), the odometry and the collision monitor's verdict on the last command
 (``/robot/safety``). It writes the command that gets around (``command``):
 
-- the child's own, while its arc is free for as far as it means to go;
+- the child's own, while its arc is free for as far as it means to go (no farther than the
+  child's goal, when its command says how far that is: ``VelocityCommand.reach``);
 - a stop while the way is blocked, for ``wait`` seconds, so a person walking across can pass;
 - then a detour: of a histogram of directions, the free one closest to where the child heads, on
   one side of the obstacle, kept within ``max_stray`` of the line the robot was on (odometry),
@@ -131,7 +132,8 @@ class AvoidObstacles(BearingsDecorator):
             self.memory = self.memory.added(scan.points(), pose, scan.stamp)
         safety = self.get_input(self.SAFETY, None)
         stopped = safety is not None and safety.state == "stopped"
-        decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped)
+        decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped,
+                                       reach=wish.reach)
         self._record(decision, pose)
         if decision.gave_up:
             self.feedback_message = decision.gave_up

@@ -49,8 +49,9 @@ class OdometryMotion(BearingsBehaviour):
     def odometry(self) -> Pose2D | None:
         return self.get_input(ODOMETRY, None)
 
-    def command(self, v: float, w: float) -> None:
-        self.set_output(COMMAND, VelocityCommand(v, w))
+    def command(self, v: float, w: float, reach: float = math.inf) -> None:
+        """Write the command; ``reach``: how far the node means to go on it before its goal (m)."""
+        self.set_output(COMMAND, VelocityCommand(v, w, reach))
 
     def blocked(self) -> bool:
         if self.get_input(STALLED, False):
@@ -100,7 +101,7 @@ class Drive(OdometryMotion):
             return Status.SUCCESS
         v = ramp(remaining, self.get_input(self.SPEED), LINEAR_DECEL, MIN_SPEED)
         w = -HEADING_GAIN * wrap_angle(pose.theta - start.theta)
-        self.command(v, w)
+        self.command(v, w, abs(remaining))
         self.feedback_message = f"{remaining:+.2f} m to go"
         return Status.RUNNING
 
@@ -153,7 +154,7 @@ class DriveTo(OdometryMotion):
         w = ramp(error, math.radians(60.0), ANGULAR_DECEL, 0.0) if error else 0.0
         v = 0.0 if abs(error) > self.TURN_IN_PLACE else ramp(distance, self.get_input(self.SPEED),
                                                               LINEAR_DECEL, MIN_SPEED) * math.cos(error)
-        self.command(v, w)
+        self.command(v, w, distance)
         self.feedback_message = f"{distance:.2f} m to go"
         return Status.RUNNING
 

@@ -19,10 +19,15 @@ from perception.ranges import RangeScan
 
 @dataclass(frozen=True, slots=True)
 class VelocityCommand:
-    """A body-frame velocity request: ``v`` forward (m/s), ``w`` counter-clockwise (rad/s)."""
+    """A body-frame velocity request: ``v`` forward (m/s), ``w`` counter-clockwise (rad/s).
+
+    ``reach``: how far (m) the node that asks means to go along this arc before it stops at its
+    goal (``inf``: no goal in sight). Bases ignore it; the avoidance judges a wish no farther
+    (``behaviours.avoidance``). Not part of equality: two requests of the same velocity are equal."""
 
     v: float = 0.0
     w: float = 0.0
+    reach: float = field(default=math.inf, compare=False)
 
     @property
     def is_zero(self) -> bool:

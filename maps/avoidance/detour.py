@@ -5,8 +5,9 @@ base gets instead, from the obstacle points around the base (:mod:`maps.avoidanc
 the robot's odometry. Three phases:
 
 - **clear**: the wish passes unchanged. A forward wish whose arc is not free for as far as it
-  means to go (:func:`maps.avoidance.sweep.needed_distance`), or one the collision monitor
-  stopped, holds the robot: it waits.
+  means to go (:func:`maps.avoidance.sweep.needed_distance`, but no farther than the node's goal
+  when the wish says where that is: ``reach``), or one the collision monitor stopped, holds the
+  robot: it waits.
 - **waiting**: stopped, so that a person walking across can pass (a blocked way that changes by
   itself costs no detour). The way clearing ends the wait; a way blocked again within
   ``clear_time`` resumes the same wait (the clock keeps running). After ``wait`` seconds still
@@ -131,9 +132,10 @@ class Avoidance:
         return self._episode.line if self._episode is not None else None
 
     def step(self, v: float, w: float, points: np.ndarray, pose: Pose2D, now: float, *,
-             stopped: bool = False) -> Decision:
+             stopped: bool = False, reach: float = math.inf) -> Decision:
         """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
-        robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command."""
+        robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command;
+        ``reach``: how far the wish means to go before the node's goal (m; ``inf``: no goal in sight)."""
         if self.settings.pass_turns and v == 0.0 and w != 0.0:  # the monitor judges a turn on the spot
             episode = self._episode
             if episode is not None and episode.detour_start is not None:
@@ -144,8 +146,8 @@ class Avoidance:
         self._pose = pose
         episode = self._episode
         if episode is not None and episode.detour_start is not None:
-            return self._detour(episode, v, w, around, pose, now, stopped)
-        blocked = self._blocked(v, w, around)
+            return self._detour(episode, v, w, around, pose, now, stopped, reach)
+        blocked = self._blocked(v, w, around, reach=reach)
         if self.phase == "clear":
             if not blocked and not (stopped and v > 0.0):
                 self._settle(now)
@@ -209,7 +211,7 @@ class Avoidance:
         return Decision(0.0, 0.0, "waiting", choice)
 
     def _detour(self, episode: _Episode, v: float, w: float, around: Surroundings, pose: Pose2D, now: float,
-                stopped: bool) -> Decision:
+                stopped: bool, reach: float) -> Decision:
         self._travelled(episode, pose)
         episode.child_turning = False
         if episode.length > self.settings.max_length:
@@ -221,7 +223,7 @@ class Avoidance:
         if v < 0.0 or (v == 0.0 and w == 0.0):  # backing away (from a stall), stopping: the monitor's to judge
             episode.clear_since = None
             return Decision(v, w, "detour", passed=True)
-        if v > 0.0 and not stopped and not self._blocked(v, w, around, at_least=self._reach(v)):
+        if v > 0.0 and not stopped and not self._blocked(v, w, around, at_least=self._reach(v), reach=reach):
             episode.held_since = None
             episode.clear_since = now if episode.clear_since is None else episode.clear_since
             if now - episode.clear_since >= self.settings.clear_time:
@@ -289,13 +291,17 @@ class Avoidance:
         self.tally.detour_time += now - (episode.detour_start or now)
 
     # -- judging the wish ------------------------------------------------------------------------
-    def _blocked(self, v: float, w: float, around: Surroundings, at_least: float = 0.0) -> bool:
-        """Is a forward wish's arc not free for as far as it means to go (or ``at_least`` that far), or
-        does it graze a point already within the clearance? Turns on the spot and backing away are
-        the collision monitor's to judge."""
+    def _blocked(self, v: float, w: float, around: Surroundings, at_least: float = 0.0, reach: float = math.inf
+                 ) -> bool:
+        """Is a forward wish's arc not free for as far as it means to go (eq. 1, or ``at_least`` that
+        far, but never beyond the node's goal ``reach`` metres on), or does it graze a point already
+        within the clearance? What lies beyond the goal does not block a wish that stops there, and the
+        goal itself may lie nearer something than the clearance (a target taken beside a desk).
+        Turns on the spot and backing away are the collision monitor's to judge."""
         if v <= 0.0:
             return False
-        return not around.open(v, w, max(needed_distance(v, self.avoid), at_least))
+        need = max(needed_distance(v, self.avoid), at_least)
+        return not around.open(v, w, need, goal=reach)
 
     def _ahead(self, v: float, w: float, points: np.ndarray) -> str:
         """Where the obstacle is, in words: along the wish's arc, or the nearest point."""

@@ -5,7 +5,9 @@ Given obstacle points around the base (sonar echoes, base frame), this module sa
 - how far a motion node commanding ``(v, w)`` means to go at least: its braking distance plus
   ``v`` times a short ``horizon`` (eq. 1, :func:`needed_distance`). A node that ramps its speed
   down as ``sqrt(2 a d)`` before its goal (``behaviours.motion.ramp``) asks, with ``decel`` equal
-  to ``a``, for ``d`` plus the horizon's travel: an obstacle beyond its goal does not block it;
+  to ``a``, for ``d`` plus the horizon's travel; a node that says where its goal is (the
+  command's ``reach``) is judged no farther (:meth:`Surroundings.open` with ``goal``): an
+  obstacle beyond its goal does not block it;
 - how far the footprint, grown by a margin, travels along the arc ``(v, w)`` before it touches a
   point (:meth:`Surroundings.free`: the exact sweep of
   :func:`perception.arc_sweep.contact_times`, times the speed), and how far straight in a
@@ -83,17 +85,19 @@ class Surroundings:
     grown: np.ndarray
     near: np.ndarray
     turn_limits: tuple[float, float] = (math.inf, math.inf)  # rad the footprint turns right, left before a touch
+    margin: float = 0.0  # m the footprint was grown by
 
     @classmethod
     def of(cls, points: np.ndarray, settings: AvoidSettings) -> Surroundings:
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         gaps = distance(settings.footprint, pts)
-        grown = grow(settings.footprint, margin(settings.footprint, pts, settings.clearance))
+        kept = margin(settings.footprint, pts, settings.clearance)
+        grown = grow(settings.footprint, kept)
         limits = (math.inf, math.inf)
         if len(pts):  # at 1 rad/s the contact time is the angle
             limits = (float(contact_times(settings.footprint, pts, 0.0, -1.0).min()),
                       float(contact_times(settings.footprint, pts, 0.0, 1.0).min()))
-        return cls(settings.footprint, pts, grown, pts[gaps < settings.clearance], limits)
+        return cls(settings.footprint, pts, grown, pts[gaps < settings.clearance], limits, kept)
 
     def free(self, v: float, w: float) -> float:
         """Metres the grown footprint goes along the arc ``(v, w)`` before it touches a point."""
@@ -105,9 +109,17 @@ class Surroundings:
         command, however far off the point is along the arc."""
         return len(self.near) > 0 and free_distance(self.footprint, self.near, v, w) <= SWEEP_LENGTH
 
-    def open(self, v: float, w: float, needed: float) -> bool:
-        """Is the arc free for ``needed`` metres, grazing nothing?"""
-        return self.free(v, w) >= needed and not self.grazes(v, w)
+    def open(self, v: float, w: float, needed: float, goal: float = math.inf) -> bool:
+        """Is the arc free for ``needed`` metres, grazing nothing? With a ``goal`` metres on, where the
+        motion ends, no farther: the footprint must not touch a point before the goal, and grown by
+        the margin it must be free up to the margin short of it, so the clearance is kept along the
+        way and the goal itself may lie nearer a point than that (a target taken beside a desk); a
+        point beyond the goal counts for nothing, not even within the clearance (the monitor's stop,
+        should it come, holds the motion all the same)."""
+        if needed <= goal - self.margin:
+            return self.free(v, w) >= needed and not self.grazes(v, w)
+        return free_distance(self.footprint, self.points, v, w) >= min(needed, goal) and \
+            self.free(v, w) >= goal - self.margin
 
     def free_towards(self, psis: np.ndarray) -> np.ndarray:
         """Metres the grown footprint goes straight in each direction ``psis`` (rad from the heading,

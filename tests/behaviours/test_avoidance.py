@@ -139,3 +139,13 @@ def test_its_status_is_the_childs():
     h.write("/robot/odometry", Pose2D(5.0, 0.0, 0.0))  # Drive got there
     assert h.tick() == Status.SUCCESS
     assert h.read("/robot/command") == VelocityCommand(0.0, 0.0)
+
+
+def test_a_child_that_stops_short_of_the_person_passes():
+    """A Drive of 0.3 m: its command says so (``reach``), and the disc meets the echoes only after
+    0.609 - sqrt(0.26^2 - 0.105^2) = 0.371 m: it stops short of the person, the avoidance lets it."""
+    node = AvoidObstacles(name="avoid", child=Drive(distance=0.3))
+    h = BehaviourHarness(node, blackboard={"/robot/odometry": Pose2D(), "/robot/ranges": scan(PERSON_AHEAD, 0.0)})
+    assert h.tick() == Status.RUNNING and command(h) == (0.3, 0.0)
+    assert h.read("/robot/command").reach == pytest.approx(0.3)
+    assert report_sections(h.behaviour)["avoidance"]["avoid"]["waits"] == 0

@@ -82,6 +82,20 @@ def test_drive_to_turns_first_then_arrives():
     assert harness.read("/robot/odometry").distance_to(Pose2D(0.0, 1.0)) <= 0.05
 
 
+def test_a_drive_says_how_far_it_means_to_go_on_its_command():
+    """``reach``: the distance left to the goal, what the avoidance judges a wish against."""
+    drive = BehaviourHarness(Drive(distance=-0.8), blackboard={"/robot/odometry": Pose2D()})
+    drive.tick()
+    assert drive.read("/robot/command").reach == pytest.approx(0.8)
+    to = BehaviourHarness(DriveTo(x=0.3, y=0.4), blackboard={"/robot/odometry": Pose2D()})
+    to.tick()
+    assert to.read("/robot/command").reach == pytest.approx(0.5)
+    turn = BehaviourHarness(Rotate(angle=90.0), blackboard={"/robot/odometry": Pose2D()})
+    turn.tick()
+    assert turn.read("/robot/command").reach == math.inf  # no goal along an arc
+    assert VelocityCommand(0.3, 0.0, 0.5) == VelocityCommand(0.3, 0.0)  # not part of the velocity
+
+
 def test_drive_to_reads_its_goal_from_the_blackboard():
     harness = BehaviourHarness(DriveTo(x="{/mission/gx}", y=0.0),
                                blackboard={"/robot/odometry": Pose2D(), "/mission/gx": 0.4})

@@ -190,3 +190,44 @@ def test_reset_tallies_what_was_going_on():
     a.reset(2.0)
     assert (a.tally.detours, a.tally.detour_length, a.tally.detour_time) == (1, pytest.approx(0.3), pytest.approx(1.5))
     assert a.phase == "clear" and a.line is None
+
+
+def test_a_wish_that_stops_at_its_goal_short_of_what_blocks_is_not_held():
+    """The person 0.34 m from the disc (0.24 m from it grown by the clearance) blocks the 0.33 m a 0.3 m/s
+    wish needs (eq. 1); a node whose goal is 0.3 m on stops 0.04 m short of them and passes; a goal
+    0.4 m on, beyond them, is held for."""
+    a = avoidance()
+    short = a.step(0.3, 0.0, PERSON, HERE, 0.0, reach=0.3)
+    assert short.passed and short.phase == "clear" and a.tally.waits == 0
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.1, reach=0.4).phase == "waiting"
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.2).phase == "waiting"  # no goal in sight: held as before
+
+
+def test_a_drive_to_a_goal_in_front_of_a_desk_arrives_without_a_hold():
+    """A drive to a goal 0.12 m short of a desk's edge, ramping down as sqrt(2 a d) with the avoidance's
+    a = 0.25 m/s^2 from 0.3 m/s; the base moves as commanded, 10 ticks a second. Within its last 0.43 m
+    the grown footprint's sweep reaches the desk, and within its last 0.10 m the disc is nearer the
+    desk than the clearance: neither holds it. Without the goal's reach the desk beyond it holds the
+    drive 0.26 + 0.1 + 0.33 m short of the desk (eq. 1)."""
+    desk = np.array([[0.9, y] for y in np.linspace(-0.6, 0.6, 25)])  # the desk's edge, odometry frame
+    goal = 0.9 - 0.26 - 0.12
+    a, x, t = avoidance(), 0.0, 0.0
+    while goal - x > 0.005:
+        v = min(0.3, float(np.sqrt(2 * 0.25 * (goal - x))))
+        decision = a.step(v, 0.0, desk - [x, 0.0], Pose2D(x, 0.0, 0.0), t, reach=goal - x)
+        assert decision.passed, f"held {goal - x:.2f} m short of the goal"
+        x, t = x + 0.1 * v, t + 0.1
+    assert a.tally.waits == 0 and a.tally.detours == 0
+    blind = avoidance()  # the same drive, its goal unknown
+    held = next(x for x in np.arange(0.0, goal, 0.01)
+                if not blind.step(0.3, 0.0, desk - [x, 0.0], Pose2D(x, 0.0, 0.0), 0.0).passed)
+    assert 0.9 - held == pytest.approx(0.26 + 0.1 + 0.33, abs=0.011)
+
+
+def test_a_detour_ends_once_the_wishs_goal_lies_short_of_the_obstacle():
+    a = avoidance(wait=0.0)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.1).phase == "detour"
+    assert a.step(0.3, 0.0, PERSON, HERE, 0.2, reach=0.2).passed  # the node now stops 0.2 m on
+    end = a.step(0.3, 0.0, PERSON, HERE, 1.2, reach=0.2)
+    assert end.phase == "clear" and end.event.startswith("past the obstacle")

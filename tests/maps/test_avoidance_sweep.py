@@ -99,3 +99,25 @@ def test_the_detour_lines_offset_is_signed_left_positive():
     assert DetourLine(0.0, 0.0, 0.0).offset(3.0, 0.4) == pytest.approx(0.4)
     assert DetourLine(1.0, 1.0, math.pi / 2).offset(0.0, 5.0) == pytest.approx(1.0)
     assert DetourLine(1.0, 1.0, math.pi / 2).offset(2.0, -3.0) == pytest.approx(-1.0)
+
+
+def test_up_to_a_goal_the_footprint_must_not_touch_and_keeps_the_clearance_but_for_the_last_margin():
+    # a point ahead, 0.25 m from the front edge: the bare square meets it after 0.25 m, grown after 0.15 m
+    ahead = around((0.45, 0.0))
+    assert not ahead.open(0.3, 0.0, needed_distance(0.3, SETTINGS))  # 0.15 m free, eq. 1 needs 0.33
+    assert ahead.open(0.3, 0.0, 0.33, goal=0.2) and ahead.open(0.3, 0.0, 0.33, goal=0.24)
+    assert not ahead.open(0.3, 0.0, 0.33, goal=0.26)  # a goal beyond the touch
+    # a point beside the way, 0.02 m outside the square's side: the bare square passes it, grown it meets
+    # it after 0.30 m (0.302 with round corners); a goal 0.35 m on is within the margin of that, 0.45 m is not
+    beside = around((0.6, 0.22))
+    assert beside.margin == pytest.approx(0.1)
+    assert beside.open(0.3, 0.0, 0.33, goal=0.35)
+    assert not beside.open(0.3, 0.0, 0.33, goal=0.45)
+
+
+def test_a_point_within_the_clearance_beyond_the_goal_does_not_block_it():
+    # 0.08 m ahead of the square's front edge: within the clearance, the margin is half of it, 0.04 m
+    near = around((0.28, 0.0))
+    assert near.margin == pytest.approx(0.04) and not near.open(0.02, 0.0, 0.01)  # grazed within the sweep
+    assert near.open(0.02, 0.0, 0.01, goal=0.05)  # the motion ends 0.03 m short of it
+    assert not near.open(0.02, 0.0, 0.01, goal=0.1)  # ... or touches it first
