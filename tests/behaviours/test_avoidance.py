@@ -117,6 +117,23 @@ def test_a_detour_that_would_stray_too_far_from_the_path_gives_up_saying_so():
     assert h.behaviour.feedback_message.endswith("; no way around within 1 m of the path")
 
 
+def test_it_tells_the_child_while_it_holds_or_detours_and_not_once_it_ends():
+    h = harness({})
+    h.tick()
+    assert h.read("/robot/avoiding") is False  # a clear way
+    told = []  # (phase, what the child is told) after each tick
+    h.tick_until(lambda s: h.behaviour.decision.phase == "detour",
+                 between=lambda h: (told.append((h.behaviour.decision.phase, h.read("/robot/avoiding"))),
+                                    sense(h, PERSON_AHEAD)))
+    assert h.read("/robot/avoiding") is True
+    assert {phase for phase, _ in told} == {"clear", "waiting"}
+    assert all(avoiding == (phase == "waiting") for phase, avoiding in told)
+    boxed = harness(BOXED_IN, timeout=1.0)
+    assert boxed.tick() == Status.RUNNING and boxed.read("/robot/avoiding") is True
+    assert boxed.tick_until(between=lambda h: sense(h, BOXED_IN)) == Status.FAILURE
+    assert boxed.read("/robot/avoiding") is False  # gave up: the recovery's child is not held
+
+
 def test_a_stop_of_the_collision_monitor_holds_the_child_too():
     h = harness({})
     h.write("/robot/safety", SafetyState(state="stopped", action="bumper", zone="front bumper"))
