@@ -16,10 +16,11 @@ child wrote (``child_command``: ``/robot/command`` unless remapped) against the 
   ahead"), after ``timeout`` seconds held, or a detour of ``max_detour`` metres that did not get
   past, so that the mission's recovery (a search pattern, a new goal) takes over.
 
-Otherwise its status is the child's. While it holds the robot or drives a detour it writes
-``avoiding`` true (``/robot/avoiding``; false again once the way is clear, and when it ends): the
-child can tell that what it sees now is partly hidden by the obstacle and that it is off its way
-for a while (``FollowRoute`` does not count losing the trail then). The algorithm is
+Otherwise its status is the child's. While it stops the robot for what is in the way (waiting,
+or on a detour with no direction that will do) it writes ``held`` true (``/robot/held``; false
+while the robot moves, and when it ends): the child can tell that what it sees now is partly
+hidden by the obstacle in front (``FollowRoute`` does not count losing the trail then). The
+robot standing still, the child's last command still means what it meant. The algorithm is
 :mod:`maps.avoidance` (pure); the echoes of the last ``memory`` seconds are judged together
 (:mod:`maps.avoidance.memory`). Without range sensors (no ``/robot/ranges``) it sees nothing and
 passes every command on; the collision monitor still limits whatever reaches the base.
@@ -98,11 +99,11 @@ class AvoidObstacles(BearingsDecorator):
                               doc="the command the child wrote this tick (its wish)")
     RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path), doc=RANGES_KEY.doc)
     SAFETY = InputPort("safety", SafetyState, Ref(SAFETY_KEY.path), doc=SAFETY_KEY.doc)
-    AVOIDING = OutputPort("avoiding", bool, "/robot/avoiding",
-                          doc="true while it holds the robot or drives a detour (the obstacle hides part of the view)")
+    HELD = OutputPort("held", bool, "/robot/held",
+                      doc="true while it stops the robot for what is in the way (which hides part of the view)")
     RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
     PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, PASS_TURNS, MEMORY,
-             ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, AVOIDING)
+             ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
@@ -138,7 +139,8 @@ class AvoidObstacles(BearingsDecorator):
         stopped = safety is not None and safety.state == "stopped"
         decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped)
         self._record(decision, pose)
-        self.set_output(self.AVOIDING, decision.phase != "clear")
+        stops = not decision.passed and decision.v == decision.w == 0.0
+        self.set_output(self.HELD, decision.phase != "clear" and stops)  # standing behind what is in the way
         if decision.gave_up:
             self.feedback_message = decision.gave_up
             self.set_output(COMMAND, STOP)
@@ -152,7 +154,7 @@ class AvoidObstacles(BearingsDecorator):
         if new_status != Status.RUNNING and self._clock is not None:
             self.avoidance.reset(self.now())
             self._close_trail()
-            self.set_output(self.AVOIDING, False)
+            self.set_output(self.HELD, False)
 
     def _record(self, decision: Decision, pose: Pose2D) -> None:
         self.decision = decision

@@ -13,8 +13,8 @@ nodes rather than in one behaviour; what they compute about a viewframe is perce
   and fails when fewer than ``min_matches`` landmarks match the viewframe for ``lost_time``
   (the trail is lost: a recovery, ``SearchPattern``, takes over); over a shorter gap it keeps the
   last command, so a few frames with too few matches between two viewframes do not stop it.
-  While ``avoiding`` (``AvoidObstacles`` round it holds the robot behind something in the way or
-  drives round it) too few matches do not count as lost: it keeps the last command and waits.
+  While ``held`` (``AvoidObstacles`` round it stops the robot behind something in the way) too
+  few matches do not count as lost: it keeps the last command and waits.
 - :class:`ViewframeSwitch` moves the target on when ``delta_t`` (eq. 1) against it falls under
   the map's threshold, or when the direction to it flips by more than 90 degrees (it was
   passed), the second rule blocked after each switch for as long as a 180 degree turn takes
@@ -37,13 +37,13 @@ How the paper is read here (where it is vague):
   50, or half a small viewframe, never under Z-infinity's 8). An observation with no usable
   estimate (no rotation, or no direction yet) counts as lost too. **Held is not lost**: a person
   standing in front of the robot hides a good part of the panorama, so the matches drop under the
-  threshold just when the avoidance holds the robot behind them or drives it off the route round
-  them. While the avoidance says so (``avoiding``) the lost timer does not run and the last
-  command is kept (the avoidance judges it: it holds the robot or steers the detour by it); the
-  avoidance's own ``timeout`` and ``max_detour`` bound that time, and once the way is clear
-  ``lost_time`` starts afresh. Otherwise every such hold ended after ``lost_time`` with a lost
-  trail and a search (a robot held between two people on the route used up the mission's
-  searches).
+  threshold just when the avoidance stops the robot behind them. While the avoidance says so
+  (``held``) the lost timer does not run and the last command is kept (the robot stands still,
+  so it still points where it pointed; the avoidance judges it); the avoidance's own ``timeout``
+  bounds that time, and once the robot moves again ``lost_time`` starts afresh. Otherwise every
+  such hold ended after ``lost_time`` with a lost trail and a search (a robot held between two
+  people on the route used up the mission's searches). On a detour the robot turns, the last
+  command no longer points to the viewframe, and lost is lost as before.
 - **Rotation.** Z-infinity down a ladder of far thresholds, with a compass as the last resort
   (:func:`perception.viewframe_motion.zinf_motion`; the module doc says why).
 - **Goal.** The switch rule fires within some radius of a viewframe (where ``delta_t`` first falls
@@ -216,7 +216,7 @@ class FollowRoute(BearingsBehaviour):
 
     RUNNING while it follows (it never ends by itself: :class:`ViewframeSwitch` ends the route);
     FAILURE when the trail is lost (fewer than ``min_matches`` landmarks match, or no usable
-    estimate, for ``lost_time`` while not ``avoiding``; until then it keeps the last command) or
+    estimate, for ``lost_time`` while not ``held``; until then it keeps the last command) or
     the base is stalled.
     Writes the velocity to ``command`` and a :class:`RouteEstimate` per new observation to
     ``estimate``.
@@ -232,14 +232,14 @@ class FollowRoute(BearingsBehaviour):
     MIN_CONFIDENCE = InputPort("min_confidence", float, 0.0, minimum=0.0, maximum=0.99,
                                doc="confidence mapped to zero speed (eq. 9)")
     LOST_TIME = InputPort("lost_time", float, 1.0, unit="s", minimum=0.0, doc="how long lost before FAILURE")
-    AVOIDING = InputPort("avoiding", bool, False,
-                         doc="true while the avoidance holds the robot or drives a detour ('{/robot/avoiding}' of "
-                             "AvoidObstacles): too few matches then do not count as lost")
+    HELD = InputPort("held", bool, False,
+                     doc="true while the avoidance stops the robot for what is in the way ('{/robot/held}' of "
+                         "AvoidObstacles): too few matches then do not count as lost")
     ROTATION = InputPort("rotation", str, "zinf", choices=("zinf", "compass"),
                          doc="zinf: rotation from far landmarks (the paper); compass: from all (for comparison)")
     ESTIMATE = OutputPort("estimate", RouteEstimate, ESTIMATE_KEY, doc="the latest estimate against the target")
     PORTS = (FOLLOW_SPEED, MIN_SPEED, TURN_RATE, HEADING_GAIN, TURN_IN_PLACE, K, MIN_CONFIDENCE, MIN_MATCHES,
-             LOST_TIME, AVOIDING, ROTATION, LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, STALLED, COMMAND, ESTIMATE)
+             LOST_TIME, HELD, ROTATION, LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, STALLED, COMMAND, ESTIMATE)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -295,7 +295,7 @@ class FollowRoute(BearingsBehaviour):
         matched = estimate.matched if estimate is not None else 0
         self.feedback_message = f"lost: {matched} landmarks match viewframe {self._target}" + (
             f" ({estimate.status})" if estimate is not None else "")
-        if self.get_input(self.AVOIDING, False):  # held behind an obstacle or going round it: not lost
+        if self.get_input(self.HELD, False):  # stopped behind an obstacle that hides the view: not lost
             self._lost_since = None
             self.feedback_message += ", held by an obstacle in the way"
         else:

@@ -117,21 +117,21 @@ def test_a_detour_that_would_stray_too_far_from_the_path_gives_up_saying_so():
     assert h.behaviour.feedback_message.endswith("; no way around within 1 m of the path")
 
 
-def test_it_tells_the_child_while_it_holds_or_detours_and_not_once_it_ends():
+def test_it_tells_the_child_while_it_stops_the_robot_and_not_once_it_moves_or_ends():
     h = harness({})
     h.tick()
-    assert h.read("/robot/avoiding") is False  # a clear way
+    assert h.read("/robot/held") is False  # a clear way
     told = []  # (phase, what the child is told) after each tick
     h.tick_until(lambda s: h.behaviour.decision.phase == "detour",
-                 between=lambda h: (told.append((h.behaviour.decision.phase, h.read("/robot/avoiding"))),
+                 between=lambda h: (told.append((h.behaviour.decision.phase, h.read("/robot/held"))),
                                     sense(h, PERSON_AHEAD)))
-    assert h.read("/robot/avoiding") is True
     assert {phase for phase, _ in told} == {"clear", "waiting"}
-    assert all(avoiding == (phase == "waiting") for phase, avoiding in told)
+    assert all(held == (phase == "waiting") for phase, held in told)
+    assert h.read("/robot/held") is False and command(h) != (0.0, 0.0)  # on a detour, moving: not held
     boxed = harness(BOXED_IN, timeout=1.0)
-    assert boxed.tick() == Status.RUNNING and boxed.read("/robot/avoiding") is True
+    assert boxed.tick() == Status.RUNNING and boxed.read("/robot/held") is True
     assert boxed.tick_until(between=lambda h: sense(h, BOXED_IN)) == Status.FAILURE
-    assert boxed.read("/robot/avoiding") is False  # gave up: the recovery's child is not held
+    assert boxed.read("/robot/held") is False  # gave up: the recovery's child is not held
 
 
 def test_a_stop_of_the_collision_monitor_holds_the_child_too():

@@ -1,7 +1,7 @@
 """Held behind someone is not lost: AvoidObstacles round FollowRoute, as follow_route.yaml wires them.
 
 A person stands close in front of the robot (every front transducer of the Pioneer 3-DX ring reads
-0.2 m) and hides the view: no landmark matches. Told by the avoidance (``/robot/avoiding``), route
+0.2 m) and hides the view: no landmark matches. Told by the avoidance (``/robot/held``), route
 following keeps the trail while the robot is held, and the avoidance's timeout ends the hold with
 its own reason (the mission then skips viewframes past the person); not told, route following
 fails after ``lost_time`` with a lost trail (the mission then searches).
@@ -41,7 +41,7 @@ def nothing_matches(stamp: float) -> Observation:
 
 @pytest.mark.parametrize("told", [True, False])
 def test_held_behind_a_person_the_avoidance_ends_the_hold_not_a_lost_trail(told):
-    wiring = {"avoiding": "{/robot/avoiding}"} if told else {}
+    wiring = {"held": "{/robot/held}"} if told else {}
     follow = FollowRoute(k=1, lost_time=LOST_TIME, **wiring)
     node = AvoidObstacles(name="avoid", child=follow, timeout=TIMEOUT)
     harness = BehaviourHarness(node, blackboard={
@@ -65,4 +65,4 @@ def test_held_behind_a_person_the_avoidance_ends_the_hold_not_a_lost_trail(told)
     else:  # the trail "lost" after lost_time (the first tick held, lost since)
         assert harness.clock.now() == pytest.approx(0.1 + LOST_TIME, abs=0.11)
         assert follow.feedback_message.startswith("lost: 0 landmarks")
-    assert harness.read("/robot/command").v == 0.0 and harness.read("/robot/avoiding") is False
+    assert harness.read("/robot/command").v == 0.0 and harness.read("/robot/held") is False
