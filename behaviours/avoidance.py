@@ -16,11 +16,11 @@ child wrote (``child_command``: ``/robot/command`` unless remapped) against the 
   ahead"), after ``timeout`` seconds held, or a detour of ``max_detour`` metres that did not get
   past, so that the mission's recovery (a search pattern, a new goal) takes over.
 
-Otherwise its status is the child's. While it stops the robot for what is in the way (waiting,
-or on a detour with no direction that will do) it writes ``held`` true (``/robot/held``; false
-while the robot moves, and when it ends): the child can tell that what it sees now is partly
-hidden by the obstacle in front (``FollowRoute`` does not count losing the trail then). The
-robot standing still, the child's last command still means what it meant. The algorithm is
+Otherwise its status is the child's. While it holds the robot for the way to clear by itself
+(the first ``wait`` seconds of a wait, before it judges the ways round) it writes ``held`` true
+(``/robot/held``; false otherwise, and when it ends): the child can tell that what it sees now is
+partly hidden by the obstacle in front, and that the avoidance is about to act (``FollowRoute``
+does not count losing the trail then, and leaves the avoidance its wait). The algorithm is
 :mod:`maps.avoidance` (pure); the echoes of the last ``memory`` seconds are judged together
 (:mod:`maps.avoidance.memory`). Without range sensors (no ``/robot/ranges``) it sees nothing and
 passes every command on; the collision monitor still limits whatever reaches the base.
@@ -100,7 +100,7 @@ class AvoidObstacles(BearingsDecorator):
     RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path), doc=RANGES_KEY.doc)
     SAFETY = InputPort("safety", SafetyState, Ref(SAFETY_KEY.path), doc=SAFETY_KEY.doc)
     HELD = OutputPort("held", bool, "/robot/held",
-                      doc="true while it stops the robot for what is in the way (which hides part of the view)")
+                      doc="true while it holds the robot for the way to clear by itself (the first 'wait' seconds)")
     RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
     PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, PASS_TURNS, MEMORY,
              ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
@@ -139,8 +139,8 @@ class AvoidObstacles(BearingsDecorator):
         stopped = safety is not None and safety.state == "stopped"
         decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped)
         self._record(decision, pose)
-        stops = not decision.passed and decision.v == decision.w == 0.0
-        self.set_output(self.HELD, decision.phase != "clear" and stops)  # standing behind what is in the way
+        # waiting, no way round judged yet (the fan is judged once the wait is over): the wait itself
+        self.set_output(self.HELD, decision.phase == "waiting" and decision.choice is None)
         if decision.gave_up:
             self.feedback_message = decision.gave_up
             self.set_output(COMMAND, STOP)
