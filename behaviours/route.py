@@ -45,10 +45,10 @@ How the paper is read here (where it is vague):
   mission's recovery skipped or searched instead (a robot held between two people on the route
   used up the mission's searches). Once the wait is over the avoidance drives a detour (the robot
   turns: the last command no longer points to the viewframe) or holds the robot with no way round
-  (nothing to wait for: the recovery's skip finds a way sooner than the avoidance's ``timeout``),
-  and lost is lost as before. Stopping the lost timer for the whole of a hold was tried and
-  dropped: in the lab with 3 people standing on the route it reached home 3 of 5, the robot
-  standing 20 s (``timeout``) behind someone again and again (docs/obstacles.md).
+  (nothing left to wait for: the recovery may skip past it), and lost is lost as before. Stopping
+  the lost timer for the whole of a hold was tried and dropped: in the lab with 3 people standing
+  on the route the robot then stood 20 s (``timeout``) behind someone again and again (95 s in
+  one repeat) and got home no more often (docs/obstacles.md).
 - **Rotation.** Z-infinity down a ladder of far thresholds, with a compass as the last resort
   (:func:`perception.viewframe_motion.zinf_motion`; the module doc says why).
 - **Goal.** The switch rule fires within some radius of a viewframe (where ``delta_t`` first falls
