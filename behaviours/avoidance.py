@@ -17,11 +17,15 @@ child wrote (``child_command``: ``/robot/command`` unless remapped) against the 
   ahead"), after ``timeout`` seconds held, or a detour of ``max_detour`` metres that did not get
   past, so that the mission's recovery (a search pattern, a new goal) takes over.
 
-Otherwise its status is the child's. The algorithm is :mod:`maps.avoidance` (pure); the echoes of
-the last ``memory`` seconds are judged together (:mod:`maps.avoidance.memory`). Without range
-sensors (no ``/robot/ranges``) it sees nothing and passes every command on; the collision monitor
-still limits whatever reaches the base. ``enabled: false`` passes every command on, for runs that
-compare with and without it.
+Otherwise its status is the child's. While it holds the robot for the way to clear by itself
+(the first ``wait`` seconds of a wait, before it judges the ways round) it writes ``held`` true
+(``/robot/held``; false otherwise, and when it ends): the child can tell that what it sees now is
+partly hidden by the obstacle in front, and that the avoidance is about to act (``FollowRoute``
+does not count losing the trail then, and leaves the avoidance its wait). The algorithm is
+:mod:`maps.avoidance` (pure); the echoes of the last ``memory`` seconds are judged together
+(:mod:`maps.avoidance.memory`). Without range sensors (no ``/robot/ranges``) it sees nothing and
+passes every command on; the collision monitor still limits whatever reaches the base.
+``enabled: false`` passes every command on, for runs that compare with and without it.
 
 Report section ``avoidance``, per node (its name): ``waits``, ``waits_cleared`` (the way cleared by
 itself), ``wait_time_s``, ``detours``, ``detour_length_m``, ``detour_time_s``, ``give_ups`` and
@@ -45,7 +49,7 @@ from py_trees.common import Status
 from behaviours.base import BearingsDecorator
 from behaviours.keys import RANGES_KEY, SAFETY_KEY
 from behaviours.motion import COMMAND, ODOMETRY
-from behaviours.ports import InputPort, Ref
+from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.telemetry import Arrows, Drawing, Event, Figure, Lines, Plot
 from drivers.interfaces import STOP, VelocityCommand
@@ -96,9 +100,11 @@ class AvoidObstacles(BearingsDecorator):
                               doc="the command the child wrote this tick (its wish)")
     RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path), doc=RANGES_KEY.doc)
     SAFETY = InputPort("safety", SafetyState, Ref(SAFETY_KEY.path), doc=SAFETY_KEY.doc)
+    HELD = OutputPort("held", bool, "/robot/held",
+                      doc="true while it holds the robot for the way to clear by itself (the first 'wait' seconds)")
     RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
     PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, PASS_TURNS, MEMORY,
-             ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND)
+             ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
@@ -135,6 +141,8 @@ class AvoidObstacles(BearingsDecorator):
         decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped,
                                        reach=wish.reach)
         self._record(decision, pose)
+        # waiting, no way round judged yet (the fan is judged once the wait is over): the wait itself
+        self.set_output(self.HELD, decision.phase == "waiting" and decision.choice is None)
         if decision.gave_up:
             self.feedback_message = decision.gave_up
             self.set_output(COMMAND, STOP)
@@ -148,6 +156,7 @@ class AvoidObstacles(BearingsDecorator):
         if new_status != Status.RUNNING and self._clock is not None:
             self.avoidance.reset(self.now())
             self._close_trail()
+            self.set_output(self.HELD, False)
 
     def _record(self, decision: Decision, pose: Pose2D) -> None:
         self.decision = decision

@@ -13,6 +13,8 @@ nodes rather than in one behaviour; what they compute about a viewframe is perce
   and fails when fewer than ``min_matches`` landmarks match the viewframe for ``lost_time``
   (the trail is lost: a recovery, ``SearchPattern``, takes over); over a shorter gap it keeps the
   last command, so a few frames with too few matches between two viewframes do not stop it.
+  While ``held`` (``AvoidObstacles`` round it holds the robot behind something in the way for
+  its wait) too few matches do not count as lost: it keeps the last command and waits too.
 - :class:`ViewframeSwitch` moves the target on when ``delta_t`` (eq. 1) against it falls under
   the map's threshold, or when the direction to it flips by more than 90 degrees (it was
   passed), the second rule blocked after each switch for as long as a 180 degree turn takes
@@ -33,7 +35,20 @@ How the paper is read here (where it is vague):
   rule fires.
 - **Lost.** Fewer matches than :func:`perception.viewframe_motion.lost_threshold` (the paper's
   50, or half a small viewframe, never under Z-infinity's 8). An observation with no usable
-  estimate (no rotation, or no direction yet) counts as lost too.
+  estimate (no rotation, or no direction yet) counts as lost too. **Held is not lost**: a person
+  standing in front of the robot hides a good part of the panorama, so the matches drop under the
+  threshold just when the avoidance holds the robot behind them, waiting for the way to clear by
+  itself before it tries a detour (its ``wait``, 2 s). While the avoidance says so (``held``)
+  the lost timer does not run and the last command is kept (the robot stands still, so it still
+  points where it pointed; the avoidance judges it). Otherwise the trail was "lost" after
+  ``lost_time`` (1 s) of every such wait, the avoidance never got to its detour, and the
+  mission's recovery skipped or searched instead (a robot held between two people on the route
+  used up the mission's searches). Once the wait is over the avoidance drives a detour (the robot
+  turns: the last command no longer points to the viewframe) or holds the robot with no way round
+  (nothing left to wait for: the recovery may skip past it), and lost is lost as before. Stopping
+  the lost timer for the whole of a hold was tried and dropped: in the lab with 3 people standing
+  on the route the robot then stood 20 s (``timeout``) behind someone again and again (95 s in
+  one repeat) and got home no more often (docs/obstacles.md).
 - **Rotation.** Z-infinity down a ladder of far thresholds, with a compass as the last resort
   (:func:`perception.viewframe_motion.zinf_motion`; the module doc says why).
 - **Goal.** The switch rule fires within some radius of a viewframe (where ``delta_t`` first falls
@@ -206,7 +221,8 @@ class FollowRoute(BearingsBehaviour):
 
     RUNNING while it follows (it never ends by itself: :class:`ViewframeSwitch` ends the route);
     FAILURE when the trail is lost (fewer than ``min_matches`` landmarks match, or no usable
-    estimate, for ``lost_time``; until then it keeps the last command) or the base is stalled.
+    estimate, for ``lost_time`` while not ``held``; until then it keeps the last command) or
+    the base is stalled.
     Writes the velocity to ``command`` and a :class:`RouteEstimate` per new observation to
     ``estimate``.
     """
@@ -221,11 +237,14 @@ class FollowRoute(BearingsBehaviour):
     MIN_CONFIDENCE = InputPort("min_confidence", float, 0.0, minimum=0.0, maximum=0.99,
                                doc="confidence mapped to zero speed (eq. 9)")
     LOST_TIME = InputPort("lost_time", float, 1.0, unit="s", minimum=0.0, doc="how long lost before FAILURE")
+    HELD = InputPort("held", bool, False,
+                     doc="true while the avoidance holds the robot for the way to clear ('{/robot/held}' of "
+                         "AvoidObstacles): too few matches then do not count as lost")
     ROTATION = InputPort("rotation", str, "zinf", choices=("zinf", "compass"),
                          doc="zinf: rotation from far landmarks (the paper); compass: from all (for comparison)")
     ESTIMATE = OutputPort("estimate", RouteEstimate, ESTIMATE_KEY, doc="the latest estimate against the target")
     PORTS = (FOLLOW_SPEED, MIN_SPEED, TURN_RATE, HEADING_GAIN, TURN_IN_PLACE, K, MIN_CONFIDENCE, MIN_MATCHES,
-             LOST_TIME, ROTATION, LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, STALLED, COMMAND, ESTIMATE)
+             LOST_TIME, HELD, ROTATION, LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, STALLED, COMMAND, ESTIMATE)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -278,12 +297,16 @@ class FollowRoute(BearingsBehaviour):
                                      f"error {math.degrees(estimate.error):+.0f} deg")
             return Status.RUNNING
         now = self.now()
-        self._lost_since = now if self._lost_since is None else self._lost_since
         matched = estimate.matched if estimate is not None else 0
         self.feedback_message = f"lost: {matched} landmarks match viewframe {self._target}" + (
             f" ({estimate.status})" if estimate is not None else "")
-        if now - self._lost_since >= self.get_input(self.LOST_TIME):
-            return self._stop(Status.FAILURE)
+        if self.get_input(self.HELD, False):  # waiting behind an obstacle that hides the view: not lost
+            self._lost_since = None
+            self.feedback_message += ", held by an obstacle in the way"
+        else:
+            self._lost_since = now if self._lost_since is None else self._lost_since
+            if now - self._lost_since >= self.get_input(self.LOST_TIME):
+                return self._stop(Status.FAILURE)
         self.set_output(COMMAND, self._coast)  # a short gap: keep on as before (STOP before any estimate)
         return Status.RUNNING
 

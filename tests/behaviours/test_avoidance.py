@@ -117,6 +117,27 @@ def test_a_detour_that_would_stray_too_far_from_the_path_gives_up_saying_so():
     assert h.behaviour.feedback_message.endswith("; no way around within 1 m of the path")
 
 
+def test_it_tells_the_child_while_it_waits_for_the_way_to_clear_and_not_after():
+    h = harness({})
+    h.tick()
+    assert h.read("/robot/held") is False  # a clear way
+    told = []  # (phase, what the child is told) after each tick
+    h.tick_until(lambda s: h.behaviour.decision.phase == "detour",
+                 between=lambda h: (told.append((h.behaviour.decision.phase, h.read("/robot/held"))),
+                                    sense(h, PERSON_AHEAD)))
+    assert {phase for phase, _ in told} == {"clear", "waiting"}
+    assert all(held == (phase == "waiting") for phase, held in told)
+    assert h.read("/robot/held") is False and command(h) != (0.0, 0.0)  # on a detour: not held
+    boxed = harness(BOXED_IN, wait=1.0, timeout=3.0)
+    held = {}  # tick time: what the child is told
+    status = boxed.tick_until(between=lambda h: (held.update({round(h.clock.now(), 1): h.read("/robot/held")}),
+                                                 sense(h, BOXED_IN)))
+    assert status == Status.FAILURE and boxed.clock.now() == pytest.approx(3.0)
+    assert all(held[t] for t in held if t < 0.95)  # the wait
+    assert not any(held[t] for t in held if t > 1.05)  # still held after it, with no way round: not told
+    assert command(boxed) == (0.0, 0.0) and boxed.read("/robot/held") is False  # gave up
+
+
 def test_a_stop_of_the_collision_monitor_holds_the_child_too():
     h = harness({})
     h.write("/robot/safety", SafetyState(state="stopped", action="bumper", zone="front bumper"))

@@ -94,6 +94,35 @@ def test_follow_route_coasts_over_a_short_gap():
     assert base.pose.x < PLACES[3].x
 
 
+def test_follow_route_held_behind_an_obstacle_is_not_lost_until_the_way_is_clear():
+    # a person in front hides the view (nothing matches) while the avoidance holds the robot: no
+    # lost timer, the last command kept for the avoidance to judge; clear again, lost_time counts
+    harness = follow_harness(Pose2D(), 3, k=1, lost_time=0.5, held="{/robot/held}")
+    IdealBase(harness, Pose2D(PLACES[3].x - 0.4, 0.0, 0.0))
+    harness.write("/robot/held", False)
+    assert harness.tick() == Status.RUNNING
+    moving = harness.read("/robot/command")
+    assert moving.v > 0
+
+    def hidden() -> None:
+        harness.clock.advance(0.1)
+        harness.write("/perception/observation", Observation(np.zeros((0, 3)), harness.clock.now(), "bearings",
+                                                             ids=np.zeros(0, dtype=np.int64)))
+
+    harness.write("/robot/held", True)
+    for _ in range(30):  # 3 s held, six times lost_time
+        hidden()
+        assert harness.tick() == Status.RUNNING and harness.read("/robot/command") == moving
+    message = "lost: 0 landmarks match viewframe 3 (lost), held by an obstacle in the way"
+    assert harness.behaviour.feedback_message == message
+    harness.write("/robot/held", False)  # the way is clear, still nothing matches: lost from now on
+    statuses = []
+    for _ in range(6):
+        hidden()
+        statuses.append(harness.tick())
+    assert statuses == [Status.RUNNING] * 5 + [Status.FAILURE]
+
+
 def test_follow_route_fails_when_stalled():
     harness = follow_harness(Pose2D(), 2)
     harness.write("/robot/stalled", True)
