@@ -119,6 +119,7 @@ class _Episode:
     backoffs: int = 0  # back-offs in this hold; after one the wait lasts until a detour starts
     backing: tuple[float, float] | None = None  # the trail point backed to (odometry), while backing
     backed: float = 0.0  # m backed in the current back-off
+    beyond: float = 0.0  # m a direction must be free for after a back-off: past where the robot was wedged
 
 
 class Avoidance:
@@ -215,7 +216,7 @@ class Avoidance:
         held = now - episode.origin
         if held < self.settings.wait:
             return Decision(0.0, 0.0, "waiting")
-        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v), pose=pose,
+        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode), pose=pose,
                         line=episode.line)
         if choice.direction is not None:
             self._end_wait(episode, now, cleared=False)
@@ -256,7 +257,7 @@ class Avoidance:
                                 passed=True)
             return Decision(v, w, "detour", passed=True)
         episode.clear_since = None
-        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v),
+        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode),
                         side=episode.side, pose=pose, line=episode.line)
         command = steer(choice, around, self.avoid)
         if choice.direction is not None and not stopped and command != (0.0, 0.0):
@@ -307,6 +308,7 @@ class Avoidance:
         if command is not None:
             return Decision(*command, "backoff")
         self.tally.backoff_length += episode.backed
+        episode.beyond = episode.backed + needed_distance(self.avoid.speed, self.avoid)
         episode.backing, episode.backed = None, 0.0
         self.phase = "waiting" if episode.detour_start is None else "detour"
         if self._backed_from is not None:  # a hold near here goes on from when the back-off ended
@@ -407,7 +409,9 @@ class Avoidance:
             episode.goal = pose.theta + wished_direction(v, w, self.avoid)
         return float(np.clip(wrap_angle(episode.goal - pose.theta), -self.avoid.spread, self.avoid.spread))
 
-    def _reach(self, v: float) -> float:
+    def _reach(self, v: float, episode: _Episode | None = None) -> float:
         """How far a detour's direction must be free: as far as the detour's speed needs, or the wish's,
-        the farther (a direction taken instead of the wish is free in the sense the wish was blocked)."""
-        return max(needed_distance(self.avoid.speed, self.avoid), needed_distance(v, self.avoid))
+        the farther (a direction taken instead of the wish is free in the sense the wish was blocked);
+        after a back-off, past where the robot was wedged (a direction ending there is no way out)."""
+        beyond = 0.0 if episode is None else episode.beyond
+        return max(needed_distance(self.avoid.speed, self.avoid), needed_distance(v, self.avoid), beyond)
