@@ -74,20 +74,20 @@ class Trail:
     def target(self, pose: Pose2D, distance: float) -> tuple[tuple[float, float] | None, Trail]:
         """The point to back to (odometry), and the trail left once the robot is there (up to and
         with it); ``None`` when no trail point lies :data:`MIN_BACK` or more away."""
-        best, previous = None, 0.0
+        nearer: tuple[float, float] | None = None  # the last point walked, and how far it lies
+        gap = 0.0
         for i in range(len(self.points) - 1, -1, -1):
-            (x, y), gap = self.points[i], math.hypot(self.points[i][0] - pose.x, self.points[i][1] - pose.y)
-            if gap >= distance and best is not None:  # between this point and the last: as far as asked
-                near, f = self.points[best], (distance - previous) / (gap - previous)
-                point = (near[0] + f * (x - near[0]), near[1] + f * (y - near[1]))
-                return point, Trail((*self.points[:i + 1], point), self.keep)
-            if gap >= MIN_BACK:
-                best, previous = i, gap
-            if gap >= distance:
-                break
-        if best is None:
+            (x, y), previous = self.points[i], gap
+            gap = math.hypot(x - pose.x, y - pose.y)
+            if gap >= distance:  # between this point and the nearer one: as far as asked
+                f = 1.0 if nearer is None else (distance - previous) / (gap - previous)
+                ex, ey = (x, y) if nearer is None else nearer
+                point = (ex + f * (x - ex), ey + f * (y - ey))
+                return point, Trail((*self.points[:i if nearer is None else i + 1], point), self.keep)
+            nearer = (x, y)
+        if gap < MIN_BACK:
             return None, self
-        return self.points[best], Trail(self.points[:best + 1], self.keep)
+        return self.points[0], Trail(self.points[:1], self.keep)
 
 
 def back_command(target: tuple[float, float], pose: Pose2D, around: Surroundings, avoid: AvoidSettings,
