@@ -25,6 +25,16 @@ the robot's odometry. Three phases:
   its turn does not happen; such a turn during a detour is the node's, not the detour's, and does
   not count towards :data:`GOING_ROUND`.
 
+Backing away (``backoff``): when, after the wait or ``wait`` seconds into a detour's hold, no
+direction will do for the obstacles around (not merely for straying), the robot backs along its
+own trail (:mod:`maps.avoidance.backoff`) up to ``distance`` metres, then judges again from there;
+after a back-off a direction must be free past where the robot was wedged (the distance backed
+plus what the detour needs), or the detour would drive straight back into the corner, and the
+way clearing no longer ends the wait (the wish would lead back in too): a detour must start. At
+most :data:`BACKOFFS_PER_HOLD` back-offs per hold; a new hold soon (within ``timeout``) after one,
+near where it began, is the same hold (its clock and back-offs go on), so driving back in and
+backing out cannot go on for ever. The timeout counts on through back-offs.
+
 Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
 without a direction, for ``timeout`` seconds (a hold the motion node's ending cut short, a route
 follower losing the trail for a moment, goes on counting when the node starts again within
