@@ -13,6 +13,8 @@ child wrote (``child_command``: ``/robot/command`` unless remapped) against the 
   one side of the obstacle, kept within ``max_stray`` of the line the robot was on (odometry),
   until the child's own arc is free again; the child then steers back to its route or path by
   itself;
+- no direction will do: backing away ``backoff`` metres along the way the robot came
+  (:mod:`maps.avoidance.backoff`), then judging again from there;
 - FAILURE, with the reason as the node's message ("blocked for 20 s by an obstacle 0.40 m
   ahead"), after ``timeout`` seconds held, or a detour of ``max_detour`` metres that did not get
   past, so that the mission's recovery (a search pattern, a new goal) takes over.
@@ -28,9 +30,9 @@ passes every command on; the collision monitor still limits whatever reaches the
 ``enabled: false`` passes every command on, for runs that compare with and without it.
 
 Report section ``avoidance``, per node (its name): ``waits``, ``waits_cleared`` (the way cleared by
-itself), ``wait_time_s``, ``detours``, ``detour_length_m``, ``detour_time_s``, ``give_ups`` and
+itself), ``wait_time_s``, ``detours``, ``detour_length_m``, ``detour_time_s``, ``backoffs``, ``backoff_m``, ``give_ups`` and
 their ``reasons``. Recording: ``avoidance/events``, ``avoidance/phase`` (0 clear, 1 waiting,
-2 detour), the histogram of directions judged (``avoidance/robot_frame/histogram``: a ray per
+2 detour, 3 backing away), the histogram of directions judged (``avoidance/robot_frame/histogram``: a ray per
 direction as far as it is free up to 1 m, the chosen one green, those that would do grey, the
 others red) with the chosen direction (``avoidance/robot_frame/chosen``), and the detours driven
 (``odometry_frame/avoidance/detours``).
