@@ -30,12 +30,12 @@ passes every command on; the collision monitor still limits whatever reaches the
 ``enabled: false`` passes every command on, for runs that compare with and without it.
 
 Report section ``avoidance``, per node (its name): ``waits``, ``waits_cleared`` (the way cleared by
-itself), ``wait_time_s``, ``detours``, ``detour_length_m``, ``detour_time_s``, ``backoffs``, ``backoff_m``, ``give_ups`` and
-their ``reasons``. Recording: ``avoidance/events``, ``avoidance/phase`` (0 clear, 1 waiting,
-2 detour, 3 backing away), the histogram of directions judged (``avoidance/robot_frame/histogram``: a ray per
-direction as far as it is free up to 1 m, the chosen one green, those that would do grey, the
-others red) with the chosen direction (``avoidance/robot_frame/chosen``), and the detours driven
-(``odometry_frame/avoidance/detours``).
+itself), ``wait_time_s``, ``detours``, ``detour_length_m``, ``detour_time_s``, ``backoffs``,
+``backoff_m``, ``give_ups`` and their ``reasons``. Recording: ``avoidance/events``,
+``avoidance/phase`` (0 clear, 1 waiting, 2 detour, 3 backing away), the histogram of directions
+judged (``avoidance/robot_frame/histogram``: a ray per direction as far as it is free up to 1 m,
+the chosen one green, those that would do grey, the others red) with the chosen direction
+(``avoidance/robot_frame/chosen``), and the detours driven (``odometry_frame/avoidance/detours``).
 """
 
 from __future__ import annotations
