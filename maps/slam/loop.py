@@ -12,9 +12,9 @@ from a few decimetres and a few tens of degrees apart share few corners to begin
 unguided matches gave 18-24 verified inliers per old keyframe (a loop needs 25) and no loop
 closed; the guided ones gave 31-40, all agreeing on the same 3.4-degree correction. The two sets
 are pooled (a new point matched both ways keeps its guided match). The matches are then verified
-in 3-D: both keyframes hold their points in their
-own base frame, on the same floor, so the same points must be related by one planar motion
-``T = (x, y, theta)`` (the new keyframe's pose in the old one's frame):
+in 3-D: both keyframes hold their points in their own base frame, on the same floor, so the same
+points must be related by one planar motion ``T = (x, y, theta)`` (the new keyframe's pose in the
+old one's frame):
 
     b_k = Rz(theta) a_k + (x, y, 0)                                                        (L1)
 
@@ -24,12 +24,12 @@ old point ``b_j`` when
 
     (b_j - T0 a_k)^T (C_b + R C_a R^T + J Sigma J^T)^-1 (b_j - T0 a_k) <= chi2_3(99 %)        (L2)
 
-(``J`` the Jacobian of ``T a`` in ``T``). RANSAC on pairs of matches (two points fix
-a planar motion, :func:`align_planar`: the weighted 2-D Procrustes solution) finds the largest set
-agreeing within the points' covariances (the gate of :mod:`maps.slam.association`: chi-square, 3
-degrees of freedom, 99 %, on ``b - T a`` with covariance ``C_b + R C_a R^T``; the height must agree
-too); Gauss-Newton on those inliers refines T and gives its covariance. A loop is accepted with at
-least ``min_inliers`` inliers: far more than chance gives (random matches agree with a motion
+(``J`` the Jacobian of ``T a`` in ``T``). RANSAC on pairs of matches (two points fix a planar
+motion, :func:`align_planar`: the weighted 2-D Procrustes solution) finds the largest set agreeing
+within the points' covariances (the gate of :mod:`maps.slam.association`: chi-square, 3 degrees of
+freedom, 99 %, on ``b - T a`` with covariance ``C_b + R C_a R^T``; the height must agree too);
+Gauss-Newton on those inliers refines T and gives its covariance. A loop is accepted with at least
+``min_inliers`` inliers: far more than chance gives (random matches agree with a motion
 fitted to two of them in a handful of cases).
 """
 
