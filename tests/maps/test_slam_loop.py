@@ -67,10 +67,22 @@ def test_pose_graph_spreads_a_loop_error_over_the_weak_edges():
     assert relative(solved[0], solved[2])[0, :2] == pytest.approx([1.0, 1.0], abs=0.05)
 
 
-def _keyframe(index: int, points: np.ndarray, descriptors: np.ndarray) -> Keyframe:
-    cov = np.broadcast_to(np.eye(3) * 0.02**2, (len(points), 3, 3)).copy()
+def _keyframe(index: int, points: np.ndarray, descriptors: np.ndarray, sigma: float = 0.02) -> Keyframe:
+    cov = np.broadcast_to(np.eye(3) * sigma**2, (len(points), 3, 3)).copy()
     return Keyframe(index, float(index), np.zeros(3), np.eye(3) * 1e-4, 0.0, 0.0, points, cov, descriptors,
                     np.full(len(points), -1, dtype=np.int64))
+
+
+def test_the_guided_gate_widens_with_the_predicted_heading_by_hand():
+    # a new point 1 m ahead (x), the old one 0.1 m to its left; points 1 cm on each axis. A heading
+    # sigma s moves a point 1 m ahead by s sideways: J Sigma J^T = diag(0, s^2, 0), so (L2) reads
+    # 0.1^2 / (2 * 0.01^2 + s^2): s = 0.05 rad gives 3.70 (inside 11.34), s = 0.02 rad gives 16.7 (outside)
+    descriptor = np.full((1, 32), 7, dtype=np.uint8)
+    new = _keyframe(1, np.array([[1.0, 0.0, 0.0]]), descriptor, sigma=0.01)
+    old = _keyframe(0, np.array([[1.0, 0.1, 0.0]]), descriptor, sigma=0.01)
+    wide, narrow = np.diag([0.0, 0.0, 0.05**2]), np.diag([0.0, 0.0, 0.02**2])
+    assert len(guided_matches(new, old, np.zeros(3), wide)[0]) == 1
+    assert len(guided_matches(new, old, np.zeros(3), narrow)[0]) == 0
 
 
 def test_a_place_of_repeated_texture_is_recognised_with_the_predicted_motion():
