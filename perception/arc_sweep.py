@@ -31,7 +31,7 @@ def contact_times(footprint: np.ndarray, points: np.ndarray, v: float, w: float)
     within one turn of the arc for ``w != 0``). ``footprint`` counter-clockwise, base frame."""
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     times = np.full(len(pts), np.inf)
-    if len(pts) == 0 or (v == 0.0 and w == 0.0):
+    if len(pts) == 0 or (v == 0.0 and abs(w) < EPS):  # no motion (a turn too slow to sweep: the straight case)
         return times
     inside = contains(footprint, pts)
     towards = np.sign(pts[:, 0]) == np.sign(v) if v != 0.0 else np.zeros(len(pts), dtype=bool)

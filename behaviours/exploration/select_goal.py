@@ -63,7 +63,9 @@ class SelectGoalPoint(BearingsBehaviour):
     changed since: a doorway's stray obstacles cleared; the cameras looked elsewhere on arrival);
     one reached or abandoned again is avoided for good. Before a selection without a reachable border
     counts, the obstacle cells that close a border a narrower disc reaches are looked at again
-    (:func:`maps.exploration.goal.verification_goal`: a VERIFY goal), once per place.
+    (:func:`maps.exploration.goal.verification_goal`: a VERIFY goal), once per place; a place
+    whose look-from point is within ``reach`` of the robot already is looked at by the look-around
+    the FAILURE starts (driving there would end at once, before the cameras turn to it).
     The mode, strikes, spent points, avoided targets and verified places outlive re-entries.
     """
 
@@ -164,6 +166,9 @@ class SelectGoalPoint(BearingsBehaviour):
             self._select(m, pose, None, travel)
         if self.goal is None and self._verify(m, pose):
             self.switch = before  # looking again is not a strike
+            if self.goal is None:
+                self.feedback_message = "a border closed where the robot stands: look around at it again"
+                return Status.FAILURE
         if self.switch.mode is Mode.DONE:
             self.feedback_message = "done: no border is reachable"
             return Status.SUCCESS
@@ -185,12 +190,19 @@ class SelectGoalPoint(BearingsBehaviour):
         self._avoid(goal.target)
 
     def _verify(self, m: ExplorationMap, pose: Pose2D) -> bool:
-        """No border is reachable: set a VERIFY goal if some border is closed only by cells worth
-        looking at again (:func:`maps.exploration.goal.verification_goal`)."""
+        """No border is reachable: is some border closed only by cells worth looking at again
+        (:func:`maps.exploration.goal.verification_goal`)? Its VERIFY goal is set, or, when the robot
+        stands at its look-from point already, the place counts as verified and no goal is set: the
+        look-around that follows the FAILURE looks at it (a goal reached at once would be spent
+        before the cameras turned that way)."""
         goal = verification_goal(m, (pose.x, pose.y), self.params, avoid=self._avoided(),
                                  verified=np.array(self.verified) if self.verified else None)
         if goal is None:
             return False
+        if math.hypot(pose.x - goal.target[0], pose.y - goal.target[1]) <= self.get_input(self.REACH):
+            self._set_goal(goal)  # recorded (the report's verifications), then looked at from here
+            self._spend(goal)
+            goal = None
         self._set_goal(goal)
         return True
 

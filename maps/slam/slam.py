@@ -16,7 +16,9 @@ cameras (:mod:`maps.slam.odometry`). Per stereo frame,
    takes a keyframe: the features not associated and nearer than ``map_depth`` become landmarks
    anchored to it; edges join it to the previous keyframe and to the keyframes whose landmarks it
    found; it is compared with the older keyframes that could see the same place
-   (:func:`maps.slam.loop.find_loop`), and a verified loop closes: the pose graph
+   (:func:`maps.slam.loop.find_loop`: by descriptor alone, and guided by the motion the pose graph
+   predicts between the two with the pose's uncertainty in the odometry frame), and a verified
+   loop closes: the pose graph
    (:mod:`maps.slam.graph`) is solved, keyframes, their landmarks and the current pose move with
    it, and the landmarks that now duplicate older ones are merged.
 
@@ -281,8 +283,10 @@ class StereoSlam:
             if view_overlap(frame, moved, max_distance=reach, max_turn=p.loop_turn):
                 candidates.append(old)
         candidates.sort(key=lambda k: float(np.hypot(*(self.graph[k.index, :2] - frame.pose[:2]))))
-        loop = find_loop(frame, candidates[: p.loop_candidates], "orb", rng=self._rng,
-                         min_inliers=p.loop_min_inliers)
+        candidates = candidates[: p.loop_candidates]
+        predicted = [(relative(self.graph[old.index], frame.pose)[0], cov + old.covariance) for old in candidates]
+        loop = find_loop(frame, candidates, "orb", rng=self._rng, min_inliers=p.loop_min_inliers,
+                         predicted=predicted)
         if loop is None:
             return None
         self.loops.append(loop)

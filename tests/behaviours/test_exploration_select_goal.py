@@ -176,6 +176,22 @@ def test_a_border_closed_by_a_clump_is_looked_at_again_before_done():
     assert report_sections(harness.behaviour)["exploration"]["verifications"] == 1
 
 
+def test_a_closed_border_seen_from_where_the_robot_stands_is_looked_at_by_the_look_around():
+    far = BehaviourHarness(select(patience=2), blackboard={MAP: clumped_gap(), POSE: Pose2D(0.5, 1.0)})
+    far.tick()
+    look_from, blocked = far.read(GOAL).target, far.read(GOAL).blocked  # 1 m short of the clump
+    harness = BehaviourHarness(select(patience=2), blackboard={MAP: clumped_gap(), POSE: Pose2D(look_from[0] - 0.3,
+                                                                                                look_from[1])})
+    # standing 0.3 m from the look-from point: a goal there would be reached at once, before the cameras
+    # turned to the clump; the place is looked at by the look-around the FAILURE starts, not a strike
+    assert harness.tick() == Status.FAILURE
+    assert harness.read(GOAL) is None and "look around at it again" in harness.behaviour.feedback_message
+    (place,) = harness.behaviour.verified  # the clump, reached by a path from here
+    assert math.dist(place, blocked) < 0.25 and harness.behaviour.switch.strikes == 0
+    assert harness.tick() == Status.FAILURE and harness.behaviour.switch.strikes == 1  # after the look: a strike
+    assert report_sections(harness.behaviour)["exploration"]["verifications"] == 1
+
+
 def test_a_clump_that_clears_when_looked_at_opens_the_border():
     harness = BehaviourHarness(select(reselect=1.0), blackboard={MAP: clumped_gap(), POSE: Pose2D(0.5, 1.0)})
     harness.tick()

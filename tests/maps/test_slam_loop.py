@@ -11,7 +11,8 @@ import pytest
 from maps.exploration.head import StereoHead
 from maps.exploration.pose import OdometryNoise
 from maps.slam.graph import Edge, compose, optimise, relative, whitener
-from maps.slam.loop import align_planar, ransac_planar
+from maps.slam.keyframes import Keyframe
+from maps.slam.loop import align_planar, find_loop, guided_matches, ransac_planar
 from maps.slam.slam import SlamParams, StereoSlam
 from maps.slam.viewpoint import Viewpoint
 from perception.camera import PinholeCamera, StereoRig
@@ -64,6 +65,49 @@ def test_pose_graph_spreads_a_loop_error_over_the_weak_edges():
     assert np.linalg.norm(solved[4, :2]) < 0.02 and abs(solved[4, 2]) < math.radians(0.5)
     assert np.linalg.norm(start[4, :2]) > 0.1  # it was open before
     assert relative(solved[0], solved[2])[0, :2] == pytest.approx([1.0, 1.0], abs=0.05)
+
+
+def _keyframe(index: int, points: np.ndarray, descriptors: np.ndarray, sigma: float = 0.02) -> Keyframe:
+    cov = np.broadcast_to(np.eye(3) * sigma**2, (len(points), 3, 3)).copy()
+    return Keyframe(index, float(index), np.zeros(3), np.eye(3) * 1e-4, 0.0, 0.0, points, cov, descriptors,
+                    np.full(len(points), -1, dtype=np.int64))
+
+
+def test_the_guided_gate_widens_with_the_predicted_heading_by_hand():
+    # a new point 1 m ahead (x), the old one 0.1 m to its left; points 1 cm on each axis. A heading
+    # sigma s moves a point 1 m ahead by s sideways: J Sigma J^T = diag(0, s^2, 0), so (L2) reads
+    # 0.1^2 / (2 * 0.01^2 + s^2): s = 0.05 rad gives 3.70 (inside 11.34), s = 0.02 rad gives 16.7 (outside)
+    descriptor = np.full((1, 32), 7, dtype=np.uint8)
+    new = _keyframe(1, np.array([[1.0, 0.0, 0.0]]), descriptor, sigma=0.01)
+    old = _keyframe(0, np.array([[1.0, 0.1, 0.0]]), descriptor, sigma=0.01)
+    wide, narrow = np.diag([0.0, 0.0, 0.05**2]), np.diag([0.0, 0.0, 0.02**2])
+    assert len(guided_matches(new, old, np.zeros(3), wide)[0]) == 1
+    assert len(guided_matches(new, old, np.zeros(3), narrow)[0]) == 0
+
+
+def test_a_place_of_repeated_texture_is_recognised_with_the_predicted_motion():
+    # the old keyframe saw 60 corners, each twice (a repeated texture: the same descriptor 2 m away); the
+    # new one sees the 60 again from T. Unguided, every corner has a look-alike: the ratio test keeps
+    # none and no loop closes. Guided by a prediction 3 degrees and 0.15 m off, with the uncertainty
+    # that says so, each corner's look-alike lies outside the gate (L2): the loop closes at T.
+    rng = np.random.default_rng(4)
+    corners = np.column_stack((rng.uniform(0.5, 3.0, 60), rng.uniform(-1.5, 1.5, 60), rng.uniform(0.0, 1.5, 60)))
+    descriptors = rng.integers(0, 256, (60, 32), dtype=np.uint8)
+    old = _keyframe(0, np.vstack((corners, corners + (0.0, 2.0, 0.0))), np.vstack((descriptors, descriptors)))
+    truth = np.array([0.3, 0.1, math.radians(20.0)])
+    seen = (corners - (truth[0], truth[1], 0.0)) @ rot_z(truth[2])  # T^-1 b: the corners in the new frame
+    new = _keyframe(40, seen + rng.normal(0.0, 0.005, seen.shape), descriptors)
+    assert find_loop(new, [old], "orb", rng=rng) is None
+    drifted = truth + (0.1, -0.1, math.radians(3.0))
+    sure = np.diag([0.1**2, 0.1**2, math.radians(2.0) ** 2])
+    a, b = guided_matches(new, old, drifted, sure)
+    assert len(a) == 60 and np.array_equal(b, a)  # each corner, none of its look-alikes
+    loop = find_loop(new, [old], "orb", rng=rng, predicted=[(drifted, sure)])
+    assert loop is not None and loop.old == 0 and loop.match.inliers == 60
+    assert loop.match.motion[:2] == pytest.approx(truth[:2], abs=0.01)
+    assert loop.match.motion[2] == pytest.approx(truth[2], abs=math.radians(0.3))
+    # a prediction that is sure of a wrong motion finds nothing to match: no loop from the gate alone
+    assert find_loop(new, [old], "orb", rng=rng, predicted=[(truth + (0.0, 0.0, math.radians(30.0)), sure)]) is None
 
 
 # -- a drifted pose pulled back -----------------------------------------------------------------

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -47,3 +48,6 @@ def test_a_point_inside_counts_when_the_command_goes_its_way():
 
 def test_no_motion_no_contact():
     assert contact_times(SQUARE, np.array([[0.6, 0.0]]), 0.0, 0.0) == [math.inf]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a turn too slow to sweep is no motion, not a division by zero
+        assert contact_times(SQUARE, np.array([[0.6, 0.0], [0.5, 0.0]]), 0.0, 1e-12).tolist() == [math.inf] * 2
