@@ -13,6 +13,8 @@ child wrote (``child_command``: ``/robot/command`` unless remapped) against the 
   one side of the obstacle, kept within ``max_stray`` of the line the robot was on (odometry),
   until the child's own arc is free again; the child then steers back to its route or path by
   itself;
+- no direction will do: backing away ``backoff`` metres along the way the robot came
+  (:mod:`maps.avoidance.backoff`), then judging again from there;
 - FAILURE, with the reason as the node's message ("blocked for 20 s by an obstacle 0.40 m
   ahead"), after ``timeout`` seconds held, or a detour of ``max_detour`` metres that did not get
   past, so that the mission's recovery (a search pattern, a new goal) takes over.
@@ -28,12 +30,12 @@ passes every command on; the collision monitor still limits whatever reaches the
 ``enabled: false`` passes every command on, for runs that compare with and without it.
 
 Report section ``avoidance``, per node (its name): ``waits``, ``waits_cleared`` (the way cleared by
-itself), ``wait_time_s``, ``detours``, ``detour_length_m``, ``detour_time_s``, ``give_ups`` and
-their ``reasons``. Recording: ``avoidance/events``, ``avoidance/phase`` (0 clear, 1 waiting,
-2 detour), the histogram of directions judged (``avoidance/robot_frame/histogram``: a ray per
-direction as far as it is free up to 1 m, the chosen one green, those that would do grey, the
-others red) with the chosen direction (``avoidance/robot_frame/chosen``), and the detours driven
-(``odometry_frame/avoidance/detours``).
+itself), ``wait_time_s``, ``detours``, ``detour_length_m``, ``detour_time_s``, ``backoffs``,
+``backoff_m``, ``give_ups`` and their ``reasons``. Recording: ``avoidance/events``,
+``avoidance/phase`` (0 clear, 1 waiting, 2 detour, 3 backing away), the histogram of directions
+judged (``avoidance/robot_frame/histogram``: a ray per direction as far as it is free up to 1 m,
+the chosen one green, those that would do grey, the others red) with the chosen direction
+(``avoidance/robot_frame/chosen``), and the detours driven (``odometry_frame/avoidance/detours``).
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.telemetry import Arrows, Drawing, Event, Figure, Lines, Plot
 from drivers.interfaces import STOP, VelocityCommand
+from maps.avoidance.backoff import BackoffSettings
 from maps.avoidance.detour import Avoidance, Decision, DetourSettings, Phase
 from maps.avoidance.directions import Choice
 from maps.avoidance.memory import ObstacleMemory
@@ -62,7 +65,7 @@ from perception.geometry import Pose2D
 from perception.polygons import disc
 from perception.ranges import RangeScan
 
-PHASES: dict[Phase, float] = {"clear": 0.0, "waiting": 1.0, "detour": 2.0}
+PHASES: dict[Phase, float] = {"clear": 0.0, "waiting": 1.0, "detour": 2.0, "backoff": 3.0}
 DRAWN_REACH = 1.0  # m: arcs are drawn as far as they are free, up to this
 CHOSEN, FREE, BLOCKED = (0, 220, 0), (170, 170, 170), (230, 60, 40)
 REASONS_KEPT = 5  # give-up reasons in the report
@@ -90,6 +93,8 @@ class AvoidObstacles(BearingsDecorator):
                           doc="a detour keeps within this of the line the robot was on when it was held")
     MAX_DETOUR = InputPort("max_detour", float, 6.0, unit="m", minimum=0.1, maximum=1000.0, literal_only=True,
                            doc="a detour this long that has not got past: FAILURE")
+    BACKOFF = InputPort("backoff", float, 0.4, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
+                        doc="no direction will do: back away this far along the way the robot came (0: never)")
     PASS_TURNS = InputPort("pass_turns", bool, False, literal_only=True,
                            doc="a wish to turn on the spot passes in every phase (a child turning by a measured angle)")
     MEMORY = InputPort("memory", float, 1.0, unit="s", minimum=0.0, maximum=10.0, literal_only=True,
@@ -103,8 +108,8 @@ class AvoidObstacles(BearingsDecorator):
     HELD = OutputPort("held", bool, "/robot/held",
                       doc="true while it holds the robot for the way to clear by itself (the first 'wait' seconds)")
     RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
-    PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, PASS_TURNS, MEMORY,
-             ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
+    PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, BACKOFF, PASS_TURNS,
+             MEMORY, ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
@@ -114,7 +119,8 @@ class AvoidObstacles(BearingsDecorator):
             turn_rate=math.radians(self.get_input(self.TURN_RATE)), max_stray=self.get_input(self.MAX_STRAY))
         self.avoidance = Avoidance(self.settings, DetourSettings(
             wait=self.get_input(self.WAIT), timeout=self.get_input(self.TIMEOUT),
-            max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS)))
+            max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS)),
+            BackoffSettings(distance=self.get_input(self.BACKOFF)))
         self.memory = ObstacleMemory(self.get_input(self.MEMORY))
         self.decision: Decision | None = None
         self._events: list[str] = []
@@ -179,7 +185,8 @@ class AvoidObstacles(BearingsDecorator):
         values: dict[str, Any] = {
             "waits": tally.waits, "waits_cleared": tally.waits_cleared, "wait_time_s": round(tally.wait_time, 2),
             "detours": tally.detours, "detour_length_m": round(tally.detour_length, 3),
-            "detour_time_s": round(tally.detour_time, 2), "give_ups": tally.give_ups,
+            "detour_time_s": round(tally.detour_time, 2), "backoffs": tally.backoffs,
+            "backoff_m": round(tally.backoff_length, 3), "give_ups": tally.give_ups,
             "reasons": tally.reasons[-REASONS_KEPT:]}
         for name, value in values.items():
             yield Figure("avoidance", f"{key}.{name}", value)

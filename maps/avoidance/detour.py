@@ -25,6 +25,16 @@ the robot's odometry. Three phases:
   its turn does not happen; such a turn during a detour is the node's, not the detour's, and does
   not count towards :data:`GOING_ROUND`.
 
+Backing away (``backoff``): when, after the wait or ``wait`` seconds into a detour's hold, no
+direction will do for the obstacles around (not merely for straying), the robot backs along its
+own trail (:mod:`maps.avoidance.backoff`) up to ``distance`` metres, then judges again from there;
+after a back-off a direction must be free past where the robot was wedged (the distance backed
+plus what the detour needs), or the detour would drive straight back into the corner, and the
+way clearing no longer ends the wait (the wish would lead back in too): a detour must start. At
+most :data:`BACKOFFS_PER_HOLD` back-offs per hold; a new hold soon (within ``timeout``) after one,
+near where it began, is the same hold (its clock and back-offs go on), so driving back in and
+backing out cannot go on for ever. The timeout counts on through back-offs.
+
 Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
 without a direction, for ``timeout`` seconds (a hold the motion node's ending cut short, a route
 follower losing the trail for a moment, goes on counting when the node starts again within
@@ -46,13 +56,15 @@ from typing import Literal
 
 import numpy as np
 
+from maps.avoidance.backoff import STEP, BackoffSettings, Trail, back_command
 from maps.avoidance.directions import Choice, choose, steer, wished_direction
 from maps.avoidance.sweep import AvoidSettings, DetourLine, Surroundings, free_distance, needed_distance
 from perception.geometry import Pose2D, wrap_angle
 from perception.polygons import distance
 
-Phase = Literal["clear", "waiting", "detour"]
+Phase = Literal["clear", "waiting", "detour", "backoff"]
 GOING_ROUND = math.pi  # rad: a detour that has turned this much is going round the obstacle, not past it
+BACKOFFS_PER_HOLD = 2  # back-offs in one hold (the hold goes on where the robot backed away from)
 RESTART_GAP = 2.0  # s: a hold cut short by the node's ending goes on when held again this soon ...
 STOOD = 0.05  # m: ... this close to where it was held
 
@@ -92,6 +104,8 @@ class Tally:
     detour_length: float = 0.0  # m driven on detours (odometry)
     detour_time: float = 0.0  # s
     give_ups: int = 0
+    backoffs: int = 0  # times the robot backed away along its trail, no direction doing
+    backoff_length: float = 0.0  # m backed (odometry)
     reasons: list[str] = field(default_factory=list)  # why, per give-up
 
 
@@ -112,14 +126,22 @@ class _Episode:
     held_since: float | None = None  # on a detour with no direction (or stopped by the monitor) since
     by_monitor: bool = False  # held because the collision monitor stopped a wish the arcs found free
     child_turning: bool = False  # the last tick passed the node's own turn on the spot (pass_turns)
+    backoffs: int = 0  # back-offs in this hold; after one the wait lasts until a detour starts
+    backing: tuple[float, float] | None = None  # the trail point backed to (odometry), while backing
+    backed: float = 0.0  # m backed in the current back-off
+    beyond: float = 0.0  # m a direction must be free for after a back-off: past where the robot was wedged
 
 
 class Avoidance:
     """Decides each tick's command for one motion node's wishes (module docstring)."""
 
-    def __init__(self, avoid: AvoidSettings, settings: DetourSettings | None = None) -> None:
+    def __init__(self, avoid: AvoidSettings, settings: DetourSettings | None = None,
+                 backoff: BackoffSettings | None = None) -> None:
         self.avoid = avoid
         self.settings = settings or DetourSettings()
+        self.backoff = backoff or BackoffSettings()
+        self.trail = Trail(keep=self.backoff.keep)
+        self._backed_from: tuple[float, float, Pose2D, int] | None = None  # (hold's origin, when, where, count)
         self.tally = Tally()
         self.phase: Phase = "clear"
         self._episode: _Episode | None = None
@@ -136,6 +158,12 @@ class Avoidance:
         """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
         robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command;
         ``reach``: how far the wish means to go before the node's goal (m; ``inf``: no goal in sight)."""
+        episode = self._episode
+        if episode is not None and episode.backing is not None:
+            backing = self._back(episode, Surroundings.of(points, self.avoid), pose, now)
+            if backing is not None:
+                return backing
+        self.trail = self.trail.added(pose)
         if self.settings.pass_turns and v == 0.0 and w != 0.0:  # the monitor judges a turn on the spot
             episode = self._episode
             if episode is not None and episode.detour_start is not None:
@@ -154,7 +182,7 @@ class Avoidance:
                 return Decision(v, w, "clear", passed=True)
             return self._hold(v, w, around, pose, now, by_monitor=not blocked)
         assert episode is not None
-        if not blocked and not episode.by_monitor:  # the way cleared while waiting: count it once it stays clear
+        if not blocked and not episode.by_monitor and not episode.backoffs:  # cleared while waiting (once it stays)
             self.phase, episode.clear_since = "clear", now
             return Decision(v, w, "clear", event=f"the way cleared after {now - episode.since:.1f} s", passed=True)
         return self._wait(episode, v, w, around, pose, now)
@@ -172,6 +200,7 @@ class Avoidance:
                 self._end_wait(episode, episode.clear_since, cleared=True)
             else:
                 self.tally.wait_time += now - episode.since
+            self.tally.backoff_length += episode.backed
         self.phase, self._episode = "clear", None
 
     # -- the phases ------------------------------------------------------------------------------
@@ -184,6 +213,7 @@ class Avoidance:
         resumed = episode is not None and episode.clear_since is not None
         if episode is None or not resumed:
             episode = self._episode = _Episode(now, DetourLine.at(pose), self._held_since(pose, now))
+            self._near_backoff(episode, pose, now)
             self.tally.waits += 1
         episode.clear_since = None
         episode.by_monitor = episode.by_monitor or by_monitor
@@ -196,7 +226,7 @@ class Avoidance:
         held = now - episode.origin
         if held < self.settings.wait:
             return Decision(0.0, 0.0, "waiting")
-        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v), pose=pose,
+        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode), pose=pose,
                         line=episode.line)
         if choice.direction is not None:
             self._end_wait(episode, now, cleared=False)
@@ -206,6 +236,9 @@ class Avoidance:
             side = {1: "left", -1: "right"}.get(choice.side, "ahead")
             return Decision(*steer(choice, around, self.avoid), "detour", choice,
                             f"detour to the {side} after {held:.1f} s")
+        backing = self._start_back(episode, choice, around, pose, now)
+        if backing is not None:
+            return backing
         if held >= self.settings.timeout:
             return self._give_up(self._blocked_reason(held, v, w, around.points, choice), now)
         return Decision(0.0, 0.0, "waiting", choice)
@@ -234,17 +267,76 @@ class Avoidance:
                                 passed=True)
             return Decision(v, w, "detour", passed=True)
         episode.clear_since = None
-        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v),
+        choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode),
                         side=episode.side, pose=pose, line=episode.line)
         command = steer(choice, around, self.avoid)
         if choice.direction is not None and not stopped and command != (0.0, 0.0):
             episode.held_since = None
         else:  # no direction will do, none that moves the robot, or the monitor stopped the last command: held
             episode.held_since = now if episode.held_since is None else episode.held_since
+            backing = self._start_back(episode, choice, around, pose, now) \
+                if now - episode.held_since >= self.settings.wait else None
+            if backing is not None:
+                return backing
             if now - episode.held_since >= self.settings.timeout:
                 return self._give_up(self._blocked_reason(now - episode.held_since, v, w, around.points, choice), now)
         episode.side = episode.side or choice.side
         return Decision(*command, "detour", choice)
+
+    def _start_back(self, episode: _Episode, choice: Choice, around: Surroundings, pose: Pose2D, now: float
+                    ) -> Decision | None:
+        """No direction will do for the obstacles around: back away along the trail
+        (:mod:`maps.avoidance.backoff`), if this hold has not done so :data:`BACKOFFS_PER_HOLD` times,
+        the trail goes back far enough and the way back is free. Not when free directions stray too far
+        (the bound holds the robot, not an obstacle)."""
+        if self.backoff.distance <= 0.0 or episode.backoffs >= BACKOFFS_PER_HOLD or choice.only_straying:
+            return None
+        target, trail = self.trail.target(pose, self.backoff.distance)
+        command = None if target is None else back_command(target, pose, around, self.avoid, self.backoff)
+        if target is None or command is None:
+            return None
+        self.trail = trail
+        episode.backing, episode.backed, episode.last = target, 0.0, pose
+        episode.backoffs += 1
+        self._backed_from = (episode.origin, now, pose, episode.backoffs)
+        self.phase = "backoff"
+        self.tally.backoffs += 1
+        away = math.hypot(target[0] - pose.x, target[1] - pose.y)
+        return Decision(*command, "backoff", event=f"no way round: backing away {away:.2f} m the way it came")
+
+    def _back(self, episode: _Episode, around: Surroundings, pose: Pose2D, now: float) -> Decision | None:
+        """A tick of backing away; None once it is over (at the trail point, backed twice the distance,
+        or the way back blocked): the phase it interrupted goes on from where the robot now stands."""
+        assert episode.backing is not None
+        if episode.last is not None:
+            episode.backed += math.hypot(pose.x - episode.last.x, pose.y - episode.last.y)
+        episode.last = pose
+        tx, ty = episode.backing
+        command = None
+        if math.hypot(tx - pose.x, ty - pose.y) > STEP and episode.backed < 2.0 * self.backoff.distance:
+            command = back_command(episode.backing, pose, around, self.avoid, self.backoff)
+        if command is not None:
+            return Decision(*command, "backoff")
+        self.tally.backoff_length += episode.backed
+        episode.beyond = episode.backed + needed_distance(self.avoid.speed, self.avoid)
+        episode.backing, episode.backed = None, 0.0
+        self.phase = "waiting" if episode.detour_start is None else "detour"
+        if self._backed_from is not None:  # a hold near here goes on from when the back-off ended
+            origin, _, where, count = self._backed_from
+            self._backed_from = (origin, now, where, count)
+        return None
+
+    def _near_backoff(self, episode: _Episode, pose: Pose2D, now: float) -> None:
+        """A new hold soon (within ``timeout``) after a back-off, near where the robot backed away from:
+        the same hold (its clock and its back-offs go on), so that driving back into the corner and
+        backing away again cannot go on for ever."""
+        record = self._backed_from
+        if record is None:
+            return
+        origin, when, where, count = record
+        if now - when <= self.settings.timeout and \
+                math.hypot(pose.x - where.x, pose.y - where.y) <= self.backoff.distance + STEP:
+            episode.origin, episode.backoffs = min(episode.origin, origin), count
 
     @staticmethod
     def _travelled(episode: _Episode, pose: Pose2D) -> None:
@@ -268,7 +360,7 @@ class Avoidance:
 
     def _give_up(self, reason: str, now: float) -> Decision:
         self.reset(now)
-        self._cut = None
+        self._cut = self._backed_from = None
         self.tally.give_ups += 1
         self.tally.reasons.append(reason)
         return Decision(0.0, 0.0, "clear", event=f"gave up: {reason}", gave_up=reason)
@@ -327,7 +419,9 @@ class Avoidance:
             episode.goal = pose.theta + wished_direction(v, w, self.avoid)
         return float(np.clip(wrap_angle(episode.goal - pose.theta), -self.avoid.spread, self.avoid.spread))
 
-    def _reach(self, v: float) -> float:
+    def _reach(self, v: float, episode: _Episode | None = None) -> float:
         """How far a detour's direction must be free: as far as the detour's speed needs, or the wish's,
-        the farther (a direction taken instead of the wish is free in the sense the wish was blocked)."""
-        return max(needed_distance(self.avoid.speed, self.avoid), needed_distance(v, self.avoid))
+        the farther (a direction taken instead of the wish is free in the sense the wish was blocked);
+        after a back-off, past where the robot was wedged (a direction ending there is no way out)."""
+        beyond = 0.0 if episode is None else episode.beyond
+        return max(needed_distance(self.avoid.speed, self.avoid), needed_distance(v, self.avoid), beyond)
