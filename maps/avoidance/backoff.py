@@ -34,7 +34,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from maps.avoidance.sweep import AvoidSettings, Surroundings, needed_distance
-from perception.arc_sweep import contact_times
 from perception.geometry import Pose2D, parent_to_frame
 
 STEP = 0.02  # m between the trail's points
@@ -101,14 +100,7 @@ def back_command(target: tuple[float, float], pose: Pose2D, around: Surroundings
         w = float(np.clip(v * 2.0 * y / (x * x + y * y), -avoid.turn_rate, avoid.turn_rate))  # eq. 7
     need = needed_distance(settings.speed, avoid)  # eq. 1, for the back-off's speed
     for command in ((v, w), (v, 0.0)):
-        if backward_free(around, *command) >= need:
+        if around.free(*command) >= need:
             return command
     return None
 
-
-def backward_free(around: Surroundings, v: float, w: float) -> float:
-    """Metres the footprint grown by the margin goes backwards along the arc ``(v, w)``, ``v < 0``,
-    before it touches a sensed point (``inf``: never within a turn)."""
-    if len(around.points) == 0:
-        return math.inf
-    return float(-v * contact_times(around.grown, around.points, v, w).min())

@@ -68,11 +68,11 @@ def margin(footprint: np.ndarray, points: np.ndarray, clearance: float) -> float
 
 
 def free_distance(footprint: np.ndarray, points: np.ndarray, v: float, w: float) -> float:
-    """Metres ``footprint`` travels along the arc ``(v, w)``, ``v > 0``, before it touches a point
-    (``inf``: never within a turn)."""
+    """Metres ``footprint`` travels along the arc ``(v, w)``, forwards or backwards (``v != 0``),
+    before it touches a point (``inf``: never within a turn)."""
     if len(points) == 0:
         return math.inf
-    return float(v * contact_times(footprint, points, v, w).min())
+    return float(abs(v) * contact_times(footprint, points, v, w).min())
 
 
 @dataclass(frozen=True, slots=True)
