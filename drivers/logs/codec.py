@@ -221,8 +221,8 @@ def mountings_on_base(transforms: Mapping[str, StaticTransform],
             continue
         position, rotation = np.zeros(3), Rotation.identity()
         for step in chain:  # from the frame up: p_parent = R p_child + t
-            position = Rotation.from_quat(step.rotation).apply(position) + step.translation
-            rotation = Rotation.from_quat(step.rotation) * rotation
+            turn = Rotation.from_quat(step.rotation)
+            position, rotation = turn.apply(position) + step.translation, turn * rotation
         axis = rotation.apply([1.0, 0.0, 0.0])
         out[frame] = Mounting(float(position[0]), float(position[1]), math.atan2(axis[1], axis[0]))
     return out
