@@ -94,6 +94,8 @@ OPTIONS = {
                       "(default: the robot's diameter or the taught viewframes' spacing, whichever is larger)",
     "rotation": "how the repeat estimates its rotation: zinf (Z-infinity, the paper; default) or compass (the "
                 "median bearing change of every landmark: the comparison for worlds with near landmarks)",
+    "cuts": "repeat from the full map and at most this many levels cut (default: every level down to one; 0: "
+            "the full map alone, e.g. to measure obstacles or people in a quarter of the time)",
     crowd.OPTION: crowd.HELP + " (the repeats': on the taught route or across it)",
 }
 ROTATIONS = ("zinf", "compass")
@@ -117,6 +119,7 @@ class Settings:
     rotation: str = "zinf"  # FollowRoute's rotation estimate (ROTATIONS)
     gap_filling: bool = True  # LearnRoute's gap filling (maps.ltmap.gaps)
     people: int = 0  # people in the repeats' world
+    cuts: int | None = None  # at most this many levels cut (None: every level)
 
 
 def check_world(world: str) -> World:
@@ -153,8 +156,13 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     gap_filling = extra.get("gap_filling", "on")
     if gap_filling not in ON_OFF:
         raise ValueError(f"gap_filling must be on or off, got {gap_filling!r}")
+    cuts = None
+    if "cuts" in extra:
+        cuts = _number(extra["cuts"], "cuts", int)
+        if cuts < 0:
+            raise ValueError(f"cuts must be >= 0 (0: the full map alone), got {cuts}")
     return Settings(camera, route, min_landmarks, tolerance, rotation, ON_OFF[gap_filling],
-                    crowd.parse_people(extra.get(crowd.OPTION)))
+                    crowd.parse_people(extra.get(crowd.OPTION)), cuts)
 
 
 def _route(world: World, text: str) -> Route:
@@ -387,7 +395,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
                            "loop_closures": report.get("ltmap", {}).get("loop_closures"),
                            "sim_time_s": report.get("sim_time_s"), **safety_figures(report)})
         plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation,
-                                 repeat_world[seed]), taught, level) for level in levels(tree, minimum)]
+                                 repeat_world[seed]), taught, level)
+                 for level in levels(tree, minimum)[:None if settings.cuts is None else settings.cuts + 1]]
     if plan:  # every repeat at once: the pool runs them in parallel
         run_sweep([episode for episode, _, _ in plan], executor=options.executor, results_dir=folder,
                   timeout_s=options.timeout_s, progress=options.progress, resume=True)

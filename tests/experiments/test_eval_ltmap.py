@@ -92,11 +92,15 @@ def test_options_are_checked_against_the_world(world_file):
                            ({"goal_tolerance": "nan"}, "positive"),
                            ({"rotation": "gyro"}, "zinf, compass"),
                            ({"gap_filling": "yes"}, "on or off"),
-                           ({"route": "loop"}, "numbers x0,y0")]:
+                           ({"route": "loop"}, "numbers x0,y0"),
+                           ({"cuts": "-1"}, "cuts must be >= 0"),
+                           ({"cuts": "all"}, "cuts: an integer")]:
         with pytest.raises(ValueError, match=message):
             check_options(path, extra)
     assert parse_route("1, 2,3,4") == [1.0, 2.0, 3.0, 4.0]
     assert check_options(path, {"camera": "landmarks"}).rotation == "zinf"
+    assert check_options(path, {"camera": "landmarks"}).cuts is None
+    assert check_options(path, {"camera": "landmarks", "cuts": "0"}).cuts == 0
     assert check_options(path, {"camera": "landmarks", "rotation": "compass"}).rotation == "compass"
 
 
@@ -205,6 +209,11 @@ def test_the_evaluation_on_a_small_world_file(world_file, tmp_path, capsys):
     assert len(table.splitlines()) == 7 + len(rows)
     assert len((out / "results.jsonl").read_text().splitlines()) == 1 + len(rows)
     assert format_table(figures) == table.rstrip("\n")
+    # the full map alone (cuts=0): one row, the same repeat (its results are reused: nothing runs)
+    assert main([*args, "--option", "cuts=0", "--resume", "--json"]) == 0
+    alone = json.loads(capsys.readouterr().out)
+    assert [r["levels_cut"] for r in alone["rows"]] == [0] and alone["rows"][0] == rows[0]
+    assert len((out / "results.jsonl").read_text().splitlines()) == 1 + len(rows)
 
 
 def test_bad_options_exit_2(world_file, capsys):
