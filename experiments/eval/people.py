@@ -5,7 +5,10 @@ run in (:func:`world_with_people`); nothing else changes, so the same seed gives
 and ``people=0`` (the default) leaves the episodes exactly as they were. Each person is, with
 even odds:
 
-- **standing** on the way the robot is to go, or
+- **standing** on the way the robot is to go, leaving it a way past on one side at least
+  (:meth:`_Placer.leaves_a_way`: room for the robot's disc grown by the avoidance's clearance
+  beside them, clear of every surface and every other person; a person in the middle of a
+  hallway too narrow for that would test only that the robot stops, which every run does), or
 - **crossing** it: walking back and forth across it, square to it, up to :data:`CROSSING` m to
   each side (cut where a wall, box or pillar comes nearer than the person's radius), at a speed
   in :data:`SPEEDS`, waiting up to :data:`WAIT_S` s at each end.
@@ -29,6 +32,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from behaviours.avoidance import AvoidObstacles
 from drivers.sim.floor import FloorGrid
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, shipped_worlds
@@ -47,6 +51,7 @@ WAIT_S = 2.0
 WALK = (1.5, 4.0)  # m: how far a walker in a room goes
 DRAWS = 500  # positions tried per person
 STEP = 0.05  # m: how finely a walk is checked against the surfaces
+PASSING = AvoidObstacles.CLEARANCE.default  # m the robot keeps passing a standing person
 
 
 def parse_people(text: str | None) -> int:
@@ -77,6 +82,27 @@ class _Placer:
         self.scene = Scene(world)
         self.keep_clear = np.asarray(keep_clear, dtype=np.float64).reshape(-1, 2)
         self.placed: list[Walker] = []
+        self.passer = world.robot_radius + PASSING  # the robot's disc grown by the clearance it keeps
+        self.standing: list[tuple[np.ndarray, np.ndarray]] = []  # (where, the way's direction) of those on a way
+
+    def leaves_a_way(self, p: np.ndarray, along: np.ndarray, extra: Walker | None = None) -> bool:
+        """Whether the robot passes a person standing at ``p`` on a way going ``along``: its disc,
+        grown by the clearance it keeps, fits beside them on one side at least, clear of every
+        surface and of everybody else standing (``extra`` too, when about to be placed). Walkers
+        move on and are not counted."""
+        normal = np.array([-along[1], along[0]])
+        others = [np.asarray(w.path[0]) for w in (*self.placed, *([extra] if extra else ()))
+                  if len(w.path) == 1 and not np.allclose(w.path[0], p)]
+        for side in (1.0, -1.0):
+            beside = p + side * normal * (RADIUS + self.passer)
+            if self.scene.clearance(*beside) >= self.passer and \
+                    all(float(np.hypot(*(beside - q))) >= RADIUS + self.passer for q in others):
+                return True
+        return False
+
+    def keeps_ways(self, walker: Walker) -> bool:
+        """Whether everybody standing on a way still leaves the robot a way past with ``walker`` placed."""
+        return len(walker.path) > 1 or all(self.leaves_a_way(p, along, walker) for p, along in self.standing)
 
     def fits(self, a: np.ndarray, b: np.ndarray | None = None) -> bool:
         """Whether a person standing at ``a`` (or walking from ``a`` to ``b``) fits: their radius
@@ -125,9 +151,12 @@ def on_ways(world: World, ways: Sequence[np.ndarray], count: int, seed: int, *,
             k = int(rng.choice(len(segments), p=lengths / lengths.sum()))
             a, b = segments[k]
             p = a + (b - a) * rng.uniform()
-            walker = _standing_or_crossing(placer, p, (b - a) / lengths[k], rng)
-            if walker is not None:
+            along = (b - a) / lengths[k]
+            walker = _standing_or_crossing(placer, p, along, rng)
+            if walker is not None and placer.keeps_ways(walker):
                 placer.placed.append(walker)
+                if len(walker.path) == 1:
+                    placer.standing.append((p, along))
                 break
     return placer.placed
 
@@ -135,7 +164,7 @@ def on_ways(world: World, ways: Sequence[np.ndarray], count: int, seed: int, *,
 def _standing_or_crossing(placer: _Placer, p: np.ndarray, along: np.ndarray,
                           rng: np.random.Generator) -> Walker | None:
     if rng.uniform() < 0.5:
-        return Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) else None
+        return Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) and placer.leaves_a_way(p, along) else None
     if not placer.apart(p, p):  # the crossing passes through p
         return None
     normal = np.array([-along[1], along[0]])

@@ -17,6 +17,7 @@ from experiments.eval.people import (
     RADIUS,
     SPACING,
     Walker,
+    _Placer,
     in_rooms,
     on_ways,
     parse_people,
@@ -106,6 +107,39 @@ def test_people_in_rooms_are_on_the_floor_the_robot_reaches(world_file):
 def test_a_world_with_no_room_gets_fewer_people(world_file):
     world = load_world(world_file(HALL))
     assert on_ways(world, [np.array([[1.0, 2.0], [2.5, 2.0]])], 3, seed=0, keep_clear=[[1.0, 2.0], [2.5, 2.0]]) == []
+
+
+def corridor(width: float) -> str:
+    return f"""
+name: corridor
+start: {{x: 0.5, y: {width / 2}, theta_deg: 0}}
+walls: [{{points: [[0, 0], [10, 0], [10, {width}], [0, {width}]], closed: true, height: 2.5}}]
+"""
+
+
+def test_nobody_stands_where_the_robot_cannot_get_past_them(world_file):
+    # the robot's disc (0.26 m) grown by the avoidance's clearance (0.10 m) beside a person (0.25 m)
+    # needs 0.25 + 2 * 0.36 = 0.97 m from the person's centre to one wall: a 1.4 m corridor has 0.7
+    way = np.array([[1.0, 0.7], [9.0, 0.7]])
+    narrow = load_world(world_file(corridor(1.4)))
+    assert all(on_ways(narrow, [way], 3, seed=s, keep_clear=[way[0], way[-1]]) == [] for s in range(5))
+    wide = load_world(world_file(corridor(2.0), "wide.yaml"))  # 1.0 m to each wall: the way past is 0.03 m wider
+    placed = [w for s in range(5) for w in on_ways(wide, [way + [0.0, 0.3]], 3, seed=s, keep_clear=[[1, 1], [9, 1]])]
+    assert any(len(w.path) == 1 for w in placed)
+
+
+def test_a_second_person_beside_the_first_closes_the_last_way_past(world_file):
+    placer = _Placer(load_world(world_file(corridor(2.0))), keep_clear=[])
+    along = np.array([1.0, 0.0])
+    first = np.array([5.0, 1.0])
+    assert placer.leaves_a_way(first, along)  # 0.39 m from the beside points to the walls, 0.36 needed
+    placer.placed.append(Walker(((5.0, 1.0),)))
+    placer.standing.append((first, along))
+    north = Walker(((5.4, 1.6),))  # 0.40 m from the north beside point (5, 1.61), 0.61 needed
+    assert placer.keeps_ways(north)  # the south side is still open
+    placer.placed.append(north)
+    assert not placer.keeps_ways(Walker(((5.4, 0.4),)))  # and now the south one closes it
+    assert placer.keeps_ways(Walker(((5.4, 0.4), (5.4, 1.0))))  # a walker moves on: not counted
 
 
 def test_the_copy_of_the_world_keeps_its_own_people_and_adds_the_drawn_ones(world_file, tmp_path):
