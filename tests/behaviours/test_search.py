@@ -57,3 +57,33 @@ def test_search_succeeds_where_the_trail_is_found_and_retargets():
     assert harness.tick() == Status.SUCCESS
     assert harness.read("/map/route_progress").target in (3, 4, 5)
     assert harness.read("/robot/command").v == 0.0 and node.found_again == 1
+
+
+class Sighted:
+    """The taught map, with only the viewframes ``seen`` matching anything: what a robot sees when
+    people and a detour have pushed it back along the route."""
+
+    def __init__(self, seen: set[int]) -> None:
+        self.seen = seen
+
+    def __getattr__(self, name: str):
+        return getattr(TREE, name)
+
+    def match(self, index: int, observation: Observation):
+        matches = TREE.match(index, observation)
+        keep = slice(None) if index in self.seen else slice(0)
+        return type(matches)(*(getattr(matches, f)[keep] for f in ("ref", "cur", "feature", "landmark", "distance")))
+
+
+@pytest.mark.parametrize(("behind", "found"), [(0, None), (3, 7), (1, None)])
+def test_search_finds_a_viewframe_already_passed_only_within_behind(behind, found):
+    # lost on the way to 9 (forward), the robot sees only 6 and 7: ahead (9, 10, 11) first, then 8, 7, 6
+    progress = RouteProgress(1, 9, TREE.viewframe_count, 0.0)
+    node = SearchPattern(window=2, behind=behind)
+    harness = BehaviourHarness(node, blackboard={"/map/ltmap": Sighted({6, 7}), "/map/route_progress": progress})
+    IdealBase(harness, PLACES[7])
+    status = harness.tick()
+    if found is None:
+        assert status == Status.RUNNING and harness.read("/map/route_progress").target == 9
+    else:
+        assert status == Status.SUCCESS and harness.read("/map/route_progress").target == found
