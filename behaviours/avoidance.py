@@ -97,6 +97,9 @@ class AvoidObstacles(BearingsDecorator):
                         doc="no direction will do: back away this far along the way the robot came (0: never)")
     PASS_TURNS = InputPort("pass_turns", bool, False, literal_only=True,
                            doc="a wish to turn on the spot passes in every phase (a child turning by a measured angle)")
+    GOING_ROUND = InputPort("going_round", bool, True, literal_only=True,
+                            doc="give up a detour that has turned 180 deg (it goes round what the child heads for); "
+                                "false for a child whose own path turns (a search pattern)")
     MEMORY = InputPort("memory", float, 1.0, unit="s", minimum=0.0, maximum=10.0, literal_only=True,
                        doc="range echoes are remembered this long (odometry frame)")
     ROBOT_RADIUS = InputPort("robot_radius", float, 0.26, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
@@ -109,7 +112,7 @@ class AvoidObstacles(BearingsDecorator):
                       doc="true while it holds the robot for the way to clear by itself (the first 'wait' seconds)")
     RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
     PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, BACKOFF, PASS_TURNS,
-             MEMORY, ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
+             GOING_ROUND, MEMORY, ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
@@ -119,7 +122,8 @@ class AvoidObstacles(BearingsDecorator):
             turn_rate=math.radians(self.get_input(self.TURN_RATE)), max_stray=self.get_input(self.MAX_STRAY))
         self.avoidance = Avoidance(self.settings, DetourSettings(
             wait=self.get_input(self.WAIT), timeout=self.get_input(self.TIMEOUT),
-            max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS)),
+            max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS),
+            going_round=self.get_input(self.GOING_ROUND)),
             BackoffSettings(distance=self.get_input(self.BACKOFF)))
         self.memory = ObstacleMemory(self.get_input(self.MEMORY))
         self.decision: Decision | None = None

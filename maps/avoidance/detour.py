@@ -78,6 +78,7 @@ class DetourSettings:
     clear_time: float = 1.0  # s the way must stay clear to end a wait or a detour
     max_length: float = 6.0  # m: a detour this long that has not got past gives up
     pass_turns: bool = False  # a wish to turn on the spot passes in every phase (nodes that turn by a measured angle)
+    going_round: bool = True  # a detour turned by GOING_ROUND gives up (off for nodes whose own path turns)
 
 
 @dataclass(frozen=True, slots=True)
@@ -250,7 +251,7 @@ class Avoidance:
         if episode.length > self.settings.max_length:
             return self._give_up(f"a detour of {episode.length:.1f} m did not get past the obstacle "
                                  f"(at most {self.settings.max_length:g} m)", now)
-        if abs(episode.turned) > GOING_ROUND:
+        if self.settings.going_round and abs(episode.turned) > GOING_ROUND:
             return self._give_up(f"the detour turned {math.degrees(abs(episode.turned)):.0f} deg: it goes round the "
                                  "obstacle, not past it", now)
         if v < 0.0 or (v == 0.0 and w == 0.0):  # backing away (from a stall), stopping: the monitor's to judge

@@ -150,6 +150,16 @@ def test_with_pass_turns_the_nodes_own_turns_do_not_count_as_the_detour_turning_
     assert gave_up.startswith("the detour turned 200 deg")
 
 
+def test_without_going_round_a_detour_that_turns_200_deg_goes_on():
+    """A search pattern's eight turns by itself: its detours turn with it, which is not going round."""
+    c = avoidance(wait=0.0, going_round=False)
+    c.step(0.3, 0.0, PERSON, HERE, 0.0)
+    assert c.step(0.3, 0.0, PERSON, HERE, 0.1).phase == "detour"
+    for i, heading in enumerate(np.radians(np.arange(20.0, 200.1, 20.0))):  # as b above: b gave up
+        decision = c.step(0.3, 0.0, PERSON, Pose2D(0.0, 0.0, float(heading)), 0.2 + 0.1 * i)
+        assert decision.gave_up == "" and decision.phase == "detour"
+
+
 def test_a_detour_that_would_stray_too_far_holds_and_gives_up_saying_so():
     a = avoidance(wait=0.0, timeout=5.0)
     assert a.step(0.3, 0.0, PERSON, HERE, 0.0).phase == "waiting"
