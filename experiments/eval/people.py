@@ -5,10 +5,10 @@ run in (:func:`world_with_people`); nothing else changes, so the same seed gives
 and ``people=0`` (the default) leaves the episodes exactly as they were. Each person is, with
 even odds:
 
-- **standing** on the way the robot is to go, leaving it a way past on one side at least
-  (:meth:`_Placer.leaves_a_way`: room for the robot's disc grown by the avoidance's clearance
-  beside them, clear of every surface and every other person; a person in the middle of a
-  hallway too narrow for that would test only that the robot stops, which every run does), or
+- **standing** on the way the robot is to go, leaving it a way past (:meth:`_Placer.leaves_a_way`:
+  the robot's disc grown by the avoidance's clearance gets from the way 1.5 m before them to the
+  way 1.5 m after them, clear of every surface and every other person standing; a person in the
+  middle of a hallway too narrow for that would test only that the robot stops), or
 - **crossing** it: walking back and forth across it, square to it, up to :data:`CROSSING` m to
   each side (cut where a wall, box or pillar comes nearer than the person's radius), at a speed
   in :data:`SPEEDS`, waiting up to :data:`WAIT_S` s at each end.
@@ -31,9 +31,10 @@ from typing import Any
 
 import numpy as np
 import yaml
+from scipy import ndimage
 
 from behaviours.avoidance import AvoidObstacles
-from drivers.sim.floor import FloorGrid
+from drivers.sim.floor import FloorGrid, rasterise
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, shipped_worlds
 from experiments.eval import count_option
@@ -52,6 +53,9 @@ WALK = (1.5, 4.0)  # m: how far a walker in a room goes
 DRAWS = 500  # positions tried per person
 STEP = 0.05  # m: how finely a walk is checked against the surfaces
 PASSING = AvoidObstacles.CLEARANCE.default  # m the robot keeps passing a standing person
+PAST = 1.5  # m along the way before and after a standing person that the robot must get between
+NEAR_END = 0.2  # m: the way's point, or a place this near it, starts and ends the way past
+GRID = 0.05  # m: the cells the way past is looked for in
 
 
 def parse_people(text: str | None) -> int:
@@ -79,30 +83,41 @@ class _Placer:
     """What every placement checks: room for a person, apart from the others, clear of given places."""
 
     def __init__(self, world: World, keep_clear: Sequence[Sequence[float]]) -> None:
+        self.world = world
         self.scene = Scene(world)
         self.keep_clear = np.asarray(keep_clear, dtype=np.float64).reshape(-1, 2)
         self.placed: list[Walker] = []
         self.passer = world.robot_radius + PASSING  # the robot's disc grown by the clearance it keeps
-        self.standing: list[tuple[np.ndarray, np.ndarray]] = []  # (where, the way's direction) of those on a way
+        self.standing: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []  # on a way: (where, before, after)
 
-    def leaves_a_way(self, p: np.ndarray, along: np.ndarray, extra: Walker | None = None) -> bool:
-        """Whether the robot passes a person standing at ``p`` on a way going ``along``: its disc,
-        grown by the clearance it keeps, fits beside them on one side at least, clear of every
-        surface and of everybody else standing (``extra`` too, when about to be placed). Walkers
-        move on and are not counted."""
-        normal = np.array([-along[1], along[0]])
-        others = [np.asarray(w.path[0]) for w in (*self.placed, *([extra] if extra else ()))
-                  if len(w.path) == 1 and not np.allclose(w.path[0], p)]
-        for side in (1.0, -1.0):
-            beside = p + side * normal * (RADIUS + self.passer)
-            if self.scene.clearance(*beside) >= self.passer and \
-                    all(float(np.hypot(*(beside - q))) >= RADIUS + self.passer for q in others):
-                return True
-        return False
+    def leaves_a_way(self, p: np.ndarray, before: np.ndarray, after: np.ndarray, extra: Walker | None = None
+                     ) -> bool:
+        """Whether the robot gets past a person standing at ``p``: from ``before`` to ``after`` (the way
+        :data:`PAST` m either side of them) its disc, grown by the clearance it keeps, finds a way
+        within a few metres, clear of every surface and of everybody standing (``extra`` too, when
+        about to be placed). Walkers move on and are not counted."""
+        standing = [np.asarray(w.path[0]) for w in (*self.placed, *([extra] if extra else ())) if len(w.path) == 1]
+        corners = np.array([p, before, after])
+        x0, y0 = corners.min(axis=0) - (PAST + self.passer)
+        x1, y1 = corners.max(axis=0) + (PAST + self.passer)
+        shape = (int(math.ceil((y1 - y0) / GRID)), int(math.ceil((x1 - x0) / GRID)))
+        free = ~rasterise(self.world, x0, y0, GRID, shape)
+        rows, cols = np.mgrid[0 : shape[0], 0 : shape[1]]
+        centres = np.stack(((cols + 0.5) * GRID + x0, (rows + 0.5) * GRID + y0), axis=-1)
+        for q in (p, *standing):
+            free &= np.hypot(*(centres - q).transpose(2, 0, 1)) > RADIUS
+        room = ndimage.distance_transform_edt(free, sampling=GRID) > self.passer
+        labels, _ = ndimage.label(room)
+        ends = []
+        for end in (before, after):  # the component nearest the way's point (the robot drove there)
+            near = labels * (np.hypot(*(centres - end).transpose(2, 0, 1)) <= NEAR_END)
+            found = np.unique(near[near > 0])
+            ends.append(set(found.tolist()))
+        return bool(ends[0] & ends[1])
 
     def keeps_ways(self, walker: Walker) -> bool:
         """Whether everybody standing on a way still leaves the robot a way past with ``walker`` placed."""
-        return len(walker.path) > 1 or all(self.leaves_a_way(p, along, walker) for p, along in self.standing)
+        return len(walker.path) > 1 or all(self.leaves_a_way(p, b, c, walker) for p, b, c in self.standing)
 
     def fits(self, a: np.ndarray, b: np.ndarray | None = None) -> bool:
         """Whether a person standing at ``a`` (or walking from ``a`` to ``b``) fits: their radius
@@ -142,29 +157,41 @@ def on_ways(world: World, ways: Sequence[np.ndarray], count: int, seed: int, *,
     from ``seed``: a point uniform along all the ways together, then standing or crossing."""
     rng = np.random.default_rng([seed, count, 0x9E09])
     placer = _Placer(world, keep_clear)
-    segments = [(a, b) for way in ways for a, b in zip(way[:-1], way[1:], strict=True) if np.hypot(*(b - a)) > 0]
+    segments = [(a, b, way, float(np.hypot(*np.diff(way[: i + 1], axis=0).T).sum()))
+                for way in ways for i, (a, b) in enumerate(zip(way[:-1], way[1:], strict=True))
+                if np.hypot(*(b - a)) > 0]  # (start, end, its way, the way's length before it)
     if not segments:
         return []
-    lengths = np.array([np.hypot(*(b - a)) for a, b in segments])
+    lengths = np.array([np.hypot(*(b - a)) for a, b, _, _ in segments])
     for _ in range(count):
         for _ in range(DRAWS):
             k = int(rng.choice(len(segments), p=lengths / lengths.sum()))
-            a, b = segments[k]
-            p = a + (b - a) * rng.uniform()
-            along = (b - a) / lengths[k]
-            walker = _standing_or_crossing(placer, p, along, rng)
+            a, b, way, start = segments[k]
+            u = rng.uniform()
+            p = a + (b - a) * u
+            around = _on_way(way, start + u * lengths[k], (-PAST, PAST))
+            walker = _standing_or_crossing(placer, p, (b - a) / lengths[k], around, rng)
             if walker is not None and placer.keeps_ways(walker):
                 placer.placed.append(walker)
                 if len(walker.path) == 1:
-                    placer.standing.append((p, along))
+                    placer.standing.append((p, *around))
                 break
     return placer.placed
 
 
+def _on_way(way: np.ndarray, s: float, offsets: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """The points of the polyline ``way`` at arc lengths ``s`` plus each of the two ``offsets``
+    (clipped to its ends)."""
+    cumulative = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(way, axis=0).T))))
+    at = np.clip(s + np.asarray(offsets, dtype=float), 0.0, cumulative[-1])
+    points = np.column_stack((np.interp(at, cumulative, way[:, 0]), np.interp(at, cumulative, way[:, 1])))
+    return points[0], points[1]
+
+
 def _standing_or_crossing(placer: _Placer, p: np.ndarray, along: np.ndarray,
-                          rng: np.random.Generator) -> Walker | None:
+                          around: tuple[np.ndarray, np.ndarray], rng: np.random.Generator) -> Walker | None:
     if rng.uniform() < 0.5:
-        return Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) and placer.leaves_a_way(p, along) else None
+        return Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) and placer.leaves_a_way(p, *around) else None
     if not placer.apart(p, p):  # the crossing passes through p
         return None
     normal = np.array([-along[1], along[0]])

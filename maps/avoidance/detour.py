@@ -40,9 +40,12 @@ without a direction, for ``timeout`` seconds (a hold the motion node's ending cu
 follower losing the trail for a moment, goes on counting when the node starts again within
 :data:`RESTART_GAP` where the robot stood: otherwise a node that fails and is restarted every
 few seconds in front of a person would hold the robot for ever) ("blocked for 20 s by an obstacle 0.40 m ahead"), a
-detour longer than ``max_length`` metres that has not got past, or one that has turned by
+detour longer than ``max_length`` metres that has not got past, one that has turned by
 :data:`GOING_ROUND` (180 degrees): it is going round the obstacle, because what the motion node
-heads for is behind it or in it (a person standing where a viewframe was taught).
+heads for is behind it or in it (a person standing where a viewframe was taught), or one that has
+got nowhere (not :data:`PROGRESS` m from where it was) for ``timeout`` seconds: turning to and fro
+on the spot between two directions, each blocked once faced (in the lab, 166 s wedged between a
+desk and two people until the time limit).
 
 Pure: no clock of its own (``now`` is passed in), no I/O; the tallies (:class:`Tally`) are what
 the run report's ``avoidance`` section shows.
@@ -67,6 +70,7 @@ GOING_ROUND = math.pi  # rad: a detour that has turned this much is going round 
 BACKOFFS_PER_HOLD = 2  # back-offs in one hold (the hold goes on where the robot backed away from)
 RESTART_GAP = 2.0  # s: a hold cut short by the node's ending goes on when held again this soon ...
 STOOD = 0.05  # m: ... this close to where it was held
+PROGRESS = 0.1  # m: a detour that has not moved this far from where it was for ``timeout`` s got nowhere
 
 
 @dataclass(frozen=True, slots=True)
@@ -131,6 +135,7 @@ class _Episode:
     backing: tuple[float, float] | None = None  # the trail point backed to (odometry), while backing
     backed: float = 0.0  # m backed in the current back-off
     beyond: float = 0.0  # m a direction must be free for after a back-off: past where the robot was wedged
+    anchor: tuple[float, Pose2D] | None = None  # (since, where): the detour has not moved PROGRESS from there since
 
 
 class Avoidance:
@@ -248,12 +253,9 @@ class Avoidance:
                 stopped: bool, reach: float) -> Decision:
         self._travelled(episode, pose)
         episode.child_turning = False
-        if episode.length > self.settings.max_length:
-            return self._give_up(f"a detour of {episode.length:.1f} m did not get past the obstacle "
-                                 f"(at most {self.settings.max_length:g} m)", now)
-        if self.settings.going_round and abs(episode.turned) > GOING_ROUND:
-            return self._give_up(f"the detour turned {math.degrees(abs(episode.turned)):.0f} deg: it goes round the "
-                                 "obstacle, not past it", now)
+        reason = self._detour_over(episode, pose, now)
+        if reason:
+            return self._give_up(reason, now)
         if v < 0.0 or (v == 0.0 and w == 0.0):  # backing away (from a stall), stopping: the monitor's to judge
             episode.clear_since = None
             return Decision(v, w, "detour", passed=True)
@@ -283,6 +285,20 @@ class Avoidance:
                 return self._give_up(self._blocked_reason(now - episode.held_since, v, w, around.points, choice), now)
         episode.side = episode.side or choice.side
         return Decision(*command, "detour", choice)
+
+    def _detour_over(self, episode: _Episode, pose: Pose2D, now: float) -> str:
+        """Why a detour gives up now ("" while it goes on): too long, going round, or getting nowhere."""
+        if episode.length > self.settings.max_length:
+            return (f"a detour of {episode.length:.1f} m did not get past the obstacle "
+                    f"(at most {self.settings.max_length:g} m)")
+        if self.settings.going_round and abs(episode.turned) > GOING_ROUND:
+            return (f"the detour turned {math.degrees(abs(episode.turned)):.0f} deg: it goes round the obstacle, "
+                    "not past it")
+        if episode.anchor is None or math.hypot(pose.x - episode.anchor[1].x, pose.y - episode.anchor[1].y) > PROGRESS:
+            episode.anchor = (now, pose)
+        elif episode.held_since is None and now - episode.anchor[0] >= self.settings.timeout:  # held: its own timeout
+            return f"the detour got nowhere for {now - episode.anchor[0]:.0f} s (within {PROGRESS:g} m)"
+        return ""
 
     def _start_back(self, episode: _Episode, choice: Choice, around: Surroundings, pose: Pose2D, now: float
                     ) -> Decision | None:

@@ -123,23 +123,23 @@ def test_nobody_stands_where_the_robot_cannot_get_past_them(world_file):
     way = np.array([[1.0, 0.7], [9.0, 0.7]])
     narrow = load_world(world_file(corridor(1.4)))
     assert all(on_ways(narrow, [way], 3, seed=s, keep_clear=[way[0], way[-1]]) == [] for s in range(5))
-    wide = load_world(world_file(corridor(2.0), "wide.yaml"))  # 1.0 m to each wall: the way past is 0.03 m wider
-    placed = [w for s in range(5) for w in on_ways(wide, [way + [0.0, 0.3]], 3, seed=s, keep_clear=[[1, 1], [9, 1]])]
+    wide = load_world(world_file(corridor(2.4), "wide.yaml"))  # 1.2 m to each wall
+    clear = [[1.0, 1.2], [9.0, 1.2]]
+    placed = [w for s in range(5) for w in on_ways(wide, [way + [0.0, 0.5]], 3, seed=s, keep_clear=clear)]
     assert any(len(w.path) == 1 for w in placed)
 
 
-def test_a_second_person_beside_the_first_closes_the_last_way_past(world_file):
-    placer = _Placer(load_world(world_file(corridor(2.0))), keep_clear=[])
-    along = np.array([1.0, 0.0])
-    first = np.array([5.0, 1.0])
-    assert placer.leaves_a_way(first, along)  # 0.39 m from the beside points to the walls, 0.36 needed
-    placer.placed.append(Walker(((5.0, 1.0),)))
-    placer.standing.append((first, along))
-    north = Walker(((5.4, 1.6),))  # 0.40 m from the north beside point (5, 1.61), 0.61 needed
+def test_a_person_beside_the_first_closes_one_side_and_a_third_the_last_way_past(world_file):
+    placer = _Placer(load_world(world_file(corridor(2.4))), keep_clear=[])
+    first, before, after = np.array([5.0, 1.2]), np.array([3.5, 1.2]), np.array([6.5, 1.2])
+    assert placer.leaves_a_way(first, before, after)  # 0.95 m on each side, 0.72 needed
+    placer.placed.append(Walker(((5.0, 1.2),)))
+    placer.standing.append((first, before, after))
+    north = Walker(((5.35, 1.85),))  # 0.3 m from the north wall, 0.24 m from the first: closed
     assert placer.keeps_ways(north)  # the south side is still open
     placer.placed.append(north)
-    assert not placer.keeps_ways(Walker(((5.4, 0.4),)))  # and now the south one closes it
-    assert placer.keeps_ways(Walker(((5.4, 0.4), (5.4, 1.0))))  # a walker moves on: not counted
+    assert not placer.keeps_ways(Walker(((5.35, 0.55),)))  # and now the south one closes it
+    assert placer.keeps_ways(Walker(((5.35, 0.55), (5.35, 1.0))))  # a walker moves on: not counted
 
 
 def test_the_copy_of_the_world_keeps_its_own_people_and_adds_the_drawn_ones(world_file, tmp_path):

@@ -160,6 +160,25 @@ def test_without_going_round_a_detour_that_turns_200_deg_goes_on():
         assert decision.gave_up == "" and decision.phase == "detour"
 
 
+def test_a_detour_that_turns_on_the_spot_and_gets_nowhere_gives_up_after_the_timeout():
+    """Each tick a direction will do and the detour turns towards it, but the robot never gets 0.1 m
+    from where it was (turning to and fro, each direction blocked once faced): after ``timeout``, it
+    gives up; one that moves on does not."""
+    stuck, moving = avoidance(wait=0.0, timeout=5.0), avoidance(wait=0.0, timeout=5.0)
+    for a in (stuck, moving):
+        a.step(0.3, 0.0, PERSON, HERE, 0.0)
+        assert a.step(0.3, 0.0, PERSON, HERE, 0.1).phase == "detour"
+    reasons, t, when = [], 0.2, 0.0
+    while t < 6.0 and not any(reasons):
+        decision = stuck.step(0.3, 0.0, PERSON, HERE, t)
+        assert decision.gave_up or decision.choice.direction is not None  # never held: a direction every tick
+        reasons.append(decision.gave_up)
+        when, t = t, t + 0.1
+    assert reasons[-1] == "the detour got nowhere for 5 s (within 0.1 m)" and when == pytest.approx(5.25, abs=0.06)
+    for i in range(60):  # 0.05 m a tick along x: 3 m in 6 s, the person always 0.6 m ahead
+        assert moving.step(0.3, 0.0, PERSON, Pose2D(0.05 * i, 0.0, 0.0), 0.2 + 0.1 * i).gave_up == ""
+
+
 def test_a_detour_that_would_stray_too_far_holds_and_gives_up_saying_so():
     a = avoidance(wait=0.0, timeout=5.0)
     assert a.step(0.3, 0.0, PERSON, HERE, 0.0).phase == "waiting"
