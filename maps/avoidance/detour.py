@@ -45,7 +45,10 @@ detour longer than ``max_length`` metres that has not got past, one that has tur
 heads for is behind it or in it (a person standing where a viewframe was taught), or one that has
 got nowhere (not :data:`PROGRESS` m from where it was) for ``timeout`` seconds: turning to and fro
 on the spot between two directions, each blocked once faced (in the lab, 166 s wedged between a
-desk and two people until the time limit).
+desk and two people until the time limit). A new detour soon after one given up (within
+``timeout``), near where it was given up (within ``max_stray``), takes the other side of the wish:
+the side the last one took led into a corner (in the lab, south of two people standing 0.24 m
+apart beside a desk, while the way past was north of both).
 
 Pure: no clock of its own (``now`` is passed in), no I/O; the tallies (:class:`Tally`) are what
 the run report's ``avoidance`` section shows.
@@ -153,6 +156,7 @@ class Avoidance:
         self._episode: _Episode | None = None
         self._pose: Pose2D | None = None  # the last tick's
         self._cut: tuple[float, float, Pose2D] | None = None  # a hold that reset cut short: (since, when, where)
+        self._failed: tuple[Pose2D, float, int] | None = None  # the last detour given up: (where, when, its side)
 
     @property
     def line(self) -> DetourLine | None:
@@ -233,7 +237,7 @@ class Avoidance:
         if held < self.settings.wait:
             return Decision(0.0, 0.0, "waiting")
         choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode), pose=pose,
-                        line=episode.line)
+                        line=episode.line, side=self._other_side(pose, now))
         if choice.direction is not None:
             self._end_wait(episode, now, cleared=False)
             episode.detour_start, episode.last, episode.side = now, pose, choice.side
@@ -255,6 +259,7 @@ class Avoidance:
         episode.child_turning = False
         reason = self._detour_over(episode, pose, now)
         if reason:
+            self._failed = (pose, now, episode.side)
             return self._give_up(reason, now)
         if v < 0.0 or (v == 0.0 and w == 0.0):  # backing away (from a stall), stopping: the monitor's to judge
             episode.clear_since = None
@@ -342,6 +347,17 @@ class Avoidance:
             origin, _, where, count = self._backed_from
             self._backed_from = (origin, now, where, count)
         return None
+
+    def _other_side(self, pose: Pose2D, now: float) -> int:
+        """The side a new detour must take (0: either): the other side of a detour given up soon
+        before (within ``timeout``), near here (within ``max_stray``), which took one side and got
+        nowhere or went round: that side led into a corner, and the other may not."""
+        failed = self._failed
+        if failed is None or not failed[2]:
+            return 0
+        where, when, side = failed
+        near = math.hypot(pose.x - where.x, pose.y - where.y) <= self.avoid.max_stray
+        return -side if near and now - when <= self.settings.timeout else 0
 
     def _near_backoff(self, episode: _Episode, pose: Pose2D, now: float) -> None:
         """A new hold soon (within ``timeout``) after a back-off, near where the robot backed away from:

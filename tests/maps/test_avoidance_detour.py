@@ -179,6 +179,25 @@ def test_a_detour_that_turns_on_the_spot_and_gets_nowhere_gives_up_after_the_tim
         assert moving.step(0.3, 0.0, PERSON, Pose2D(0.05 * i, 0.0, 0.0), 0.2 + 0.1 * i).gave_up == ""
 
 
+def test_a_detour_soon_after_one_given_up_near_there_takes_the_other_side():
+    a = avoidance(wait=0.0, max_length=1.0)
+    a.step(0.3, 0.0, PERSON, HERE, 0.0)
+    first = a.step(0.3, 0.0, PERSON, HERE, 0.1)
+    assert first.phase == "detour" and first.choice is not None and first.choice.side != 0
+    assert a.step(0.3, 0.0, PERSON, Pose2D(1.2, 0.0, 0.0), 0.2).gave_up.startswith("a detour of 1.2 m")
+    there = Pose2D(1.2, 0.0, 0.0)
+    a.step(0.3, 0.0, PERSON, there, 0.3)  # held again where it gave up: waiting, then a detour
+    again = a.step(0.3, 0.0, PERSON, there, 0.4)
+    assert again.phase == "detour" and again.choice is not None and again.choice.side == -first.choice.side
+    fresh = avoidance(wait=0.0, max_length=1.0)  # the same place without that memory: the first side again
+    fresh.step(0.3, 0.0, PERSON, there, 0.3)
+    assert fresh.step(0.3, 0.0, PERSON, there, 0.4).choice.side == first.choice.side
+    far = Pose2D(4.0, 0.0, 0.0)  # farther than max_stray (1.5 m) from where it gave up: either side
+    a.reset(0.5)
+    a.step(0.3, 0.0, PERSON, far, 0.6)
+    assert a.step(0.3, 0.0, PERSON, far, 0.7).choice.side == first.choice.side
+
+
 def test_a_detour_that_would_stray_too_far_holds_and_gives_up_saying_so():
     a = avoidance(wait=0.0, timeout=5.0)
     assert a.step(0.3, 0.0, PERSON, HERE, 0.0).phase == "waiting"
