@@ -200,14 +200,16 @@ def _go(host: RoutineBehaviour, goal: Pose2D, what: str) -> Step[float]:
 
 def _free_end(host: RoutineBehaviour, here: Pose2D, goal: Pose2D) -> tuple[tuple[float, float], float]:
     """Where a straight drive from ``here`` to ``goal`` ends (odometry) and how far short of the goal:
-    at the goal, or where something the range sensors show would hold it (:func:`straight_reach`)."""
+    at the goal, or where something the range sensors show at the goal would hold it
+    (:func:`straight_reach`; what stands in the middle of the way is the avoidance's to drive round)."""
     points = host.sensed()
     dx, dy = goal.x - here.x, goal.y - here.y
     length = math.hypot(dx, dy)
     if points is None or length == 0.0:
         return (goal.x, goal.y), 0.0
     heading = math.atan2(dy, dx)
-    reach = straight_reach(points, host.get_input(ROBOT_RADIUS), wrap_angle(heading - here.theta), length)
+    reach = straight_reach(points, host.get_input(ROBOT_RADIUS), wrap_angle(heading - here.theta), length,
+                           at_end=True)
     if reach >= length:
         return (goal.x, goal.y), 0.0
     return (here.x + reach * math.cos(heading), here.y + reach * math.sin(heading)), length - reach

@@ -30,15 +30,20 @@ CLEARANCE = 0.10  # m: kept ahead of a move; the collision monitor's default sto
 
 
 def straight_reach(points: np.ndarray, radius: float, direction: float, length: float,
-                   clearance: float = CLEARANCE) -> float:
+                   clearance: float = CLEARANCE, *, at_end: bool = False) -> float:
     """Metres a disc robot of ``radius`` may drive straight in ``direction`` (rad in the base frame,
     0 ahead, left positive; backwards is ``pi``) on a move of ``length`` metres, before a sensed point
-    (``points``, base frame, N x 2) would hold it (module docstring); ``inf`` when nothing does."""
+    (``points``, base frame, N x 2) would hold it (module docstring); ``inf`` when nothing does.
+    ``at_end``: only what stands at the move's end counts (points within ``radius + clearance`` of
+    where it ends): a long drive is not cut short by something in the middle of its way, which the
+    avoidance drives round, only by what it cannot get past (a desk beside its goal)."""
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
-    if len(pts) == 0:
-        return math.inf
     c, s = math.cos(direction), math.sin(direction)
     along = np.column_stack((c * pts[:, 0] + s * pts[:, 1], -s * pts[:, 0] + c * pts[:, 1]))  # the move along +x
+    if at_end:
+        along = along[np.hypot(along[:, 0] - length, along[:, 1]) < radius + clearance]
+    if len(along) == 0:
+        return math.inf
     touched = contact_times(disc(radius), along, 1.0, 0.0) <= length + SWEEP_LENGTH  # at 1 m/s, seconds are metres
     if not touched.any():
         return math.inf

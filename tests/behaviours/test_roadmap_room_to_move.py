@@ -40,6 +40,13 @@ def test_points_beside_the_way_beyond_the_sweep_or_none_hold_nothing():
     assert straight_reach(np.zeros((0, 2)), RADIUS, 0.0, 1.0) == math.inf
 
 
+def test_at_the_end_only_what_stands_at_the_goal_cuts_a_drive_short():
+    middle, end = np.array([[1.0, 0.0]]), np.array([[2.3, 0.0]])  # a person half-way, a desk 0.02 m past the goal
+    assert straight_reach(middle, RADIUS, 0.0, 2.0, at_end=True) == math.inf  # the avoidance's to drive round
+    assert straight_reach(np.vstack((middle, end)), RADIUS, 0.0, 2.0, at_end=True) == pytest.approx(2.3 - 0.38)
+    assert straight_reach(middle, RADIUS, 0.0, 2.0) == pytest.approx(1.0 - 0.38)
+
+
 def test_a_point_already_within_the_clearance_ahead_leaves_no_room():
     assert straight_reach(np.array([[0.33, 0.0]]), RADIUS, 0.0, 0.25) == 0.0
 
