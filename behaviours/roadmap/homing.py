@@ -29,14 +29,11 @@ image after a step of known length". One round here:
    that fails (no match after the step, no parallax, disagreement) is not driven on: the image
    after the step starts the next triangle, on the other side.
 5. **Go**: drive there (along a planned path when a room estimate is known and the goal is more
-   than 0.5 m away) and turn to its heading. A straight drive is judged against the range
-   sensors first and ends where something sensed is in its way (a target taken beside a desk,
-   nearer it than the collision monitor's stop margin, is reached but not passed; an estimate a
-   few centimetres into the desk is not driven to). When the estimate is within ``done_distance``
-   of where the robot stood when the round began, and the drive ended within ``done_distance``
-   of it, the robot was there already: homing succeeds, and the result is that estimated pose
-   (in the odometry frame), not the odometry after driving (which adds the drive's error). So
-   homing takes at least two rounds: one to get there, one to confirm.
+   than 0.5 m away) and turn to its heading. When the estimate is within ``done_distance``
+   of where the robot stood when the round began, the robot was there already: homing
+   succeeds, and the result is that estimated pose (in the odometry frame), not the odometry
+   after driving (which adds the drive's error). So homing takes at least two rounds: one to
+   get there, one to confirm.
 
 A first image that gives the turn but no direction (no parallax left after the turn: the
 camera is within a few centimetres of the target, or along its optical axis within about 3 %
@@ -173,46 +170,25 @@ def home(host: RoutineBehaviour, target: TargetView, settings: HomingSettings) -
         rounds += 1
         goal = estimate[0]
         correction = goal.distance_to(start) if start is not None else math.inf
-        short = yield from _go(host, goal, f"homing on {target.name} ({correction:.2f} m)")
-        if correction < settings.done_distance and short < settings.done_distance:  # found where it started: there
+        yield from _go(host, goal, f"homing on {target.name} ({correction:.2f} m)")
+        if correction < settings.done_distance:  # the round found the robot where it started: it is there
             return HomingResult(target.name, goal, correction, rounds, first.comparison.inliers, host.now())
     raise Failed(f"homing on {target.name} did not converge in {settings.max_rounds} rounds")
 
 
-def _go(host: RoutineBehaviour, goal: Pose2D, what: str) -> Step[float]:
+def _go(host: RoutineBehaviour, goal: Pose2D, what: str) -> Step[None]:
     """Drive to an odometry pose: along a planned path when a room estimate is known and the goal is
     farther than ``PLANNED_BEYOND`` (homing from afar must not run into the furniture in between),
-    else straight, as far as the range sensors show the way free (:func:`_free_end`). Returns how
-    far short of the goal the drive ended (m; 0 at the goal)."""
+    else straight."""
     room = room_of(host)
     here = yield from host.pose()
     if room is not None and here.distance_to(goal) > PLANNED_BEYOND:
         try:
             yield from travel(host, room, room.to_reference(goal), turn=True)
-            return 0.0
+            return
         except Failed:
             pass  # no path in the room estimate (a target off the free polygon): straight, as without a room
-    (x, y), short = _free_end(host, here, goal)
-    yield from host.drive_to(x, y, what)
-    yield from host.turn_to(goal.theta, what)
-    return short
-
-
-def _free_end(host: RoutineBehaviour, here: Pose2D, goal: Pose2D) -> tuple[tuple[float, float], float]:
-    """Where a straight drive from ``here`` to ``goal`` ends (odometry) and how far short of the goal:
-    at the goal, or where something the range sensors show at the goal would hold it
-    (:func:`straight_reach`; what stands in the middle of the way is the avoidance's to drive round)."""
-    points = host.sensed()
-    dx, dy = goal.x - here.x, goal.y - here.y
-    length = math.hypot(dx, dy)
-    if points is None or length == 0.0:
-        return (goal.x, goal.y), 0.0
-    heading = math.atan2(dy, dx)
-    reach = straight_reach(points, host.get_input(ROBOT_RADIUS), wrap_angle(heading - here.theta), length,
-                           at_end=True)
-    if reach >= length:
-        return (goal.x, goal.y), 0.0
-    return (here.x + reach * math.cos(heading), here.y + reach * math.sin(heading)), length - reach
+    yield from host.go_to_pose(goal, what)
 
 
 def _step_motion(first: Look, side: int) -> tuple[float, float]:

@@ -1,19 +1,17 @@
-"""How far a homing's straight move may go by what the range sensors show, judged before it starts.
+"""How far a homing's sidestep may go by what the range sensors show, judged before it starts.
 
-A homing measures its way: a sidestep of known length for the third image, then a drive to the
-estimate (:mod:`behaviours.roadmap.homing`). Started blind, a sidestep towards a desk a few
-decimetres away is held by the avoidance (``AvoidObstacles``: it waits, then drives a detour, which
-cannot help a measured step), or stopped by the collision monitor, and the homing and the detour
-fight; a drive to a target taken beside a desk (nearer it than the clearance) is held short of the
-goal in the same way. So the homing judges each move against the echoes around the base first
-(:func:`straight_reach`), and takes the other side, a shorter step, or a drive that ends where the
-way is blocked.
+A homing measures its way: a sidestep of known length for the third image
+(:mod:`behaviours.roadmap.homing`). Started blind, a sidestep towards a desk a few decimetres away
+is held by the avoidance (``AvoidObstacles``: it waits, then drives a detour, which cannot help a
+measured step) or stopped by the collision monitor, and the homing and the detour fight: beside
+a desk, a navigation took minutes. So the homing judges the step against the echoes around the
+base first (:func:`straight_reach`), and takes the other side or a shorter step.
 
 The rule mirrors the collision monitor's stop zone (docs/failure.md): a sensed point counts when
 the robot's disc, driving straight on, would touch it within the move plus the monitor's sweep
 (:data:`perception.collision_monitor.SWEEP_LENGTH`); the move may go as far as the disc grown by
 ``clearance`` goes before it meets such a point. A point beside the way, which the disc passes
-however near, counts for nothing (a target beside a desk is reached along the desk).
+however near, counts for nothing.
 """
 
 from __future__ import annotations
@@ -30,20 +28,15 @@ CLEARANCE = 0.10  # m: kept ahead of a move; the collision monitor's default sto
 
 
 def straight_reach(points: np.ndarray, radius: float, direction: float, length: float,
-                   clearance: float = CLEARANCE, *, at_end: bool = False) -> float:
+                   clearance: float = CLEARANCE) -> float:
     """Metres a disc robot of ``radius`` may drive straight in ``direction`` (rad in the base frame,
     0 ahead, left positive; backwards is ``pi``) on a move of ``length`` metres, before a sensed point
-    (``points``, base frame, N x 2) would hold it (module docstring); ``inf`` when nothing does.
-    ``at_end``: only what stands at the move's end counts (points within ``radius + clearance`` of
-    where it ends): a long drive is not cut short by something in the middle of its way, which the
-    avoidance drives round, only by what it cannot get past (a desk beside its goal)."""
+    (``points``, base frame, N x 2) would hold it (module docstring); ``inf`` when nothing does."""
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     c, s = math.cos(direction), math.sin(direction)
-    along = np.column_stack((c * pts[:, 0] + s * pts[:, 1], -s * pts[:, 0] + c * pts[:, 1]))  # the move along +x
-    if at_end:
-        along = along[np.hypot(along[:, 0] - length, along[:, 1]) < radius + clearance]
-    if len(along) == 0:
+    if len(pts) == 0:
         return math.inf
+    along = np.column_stack((c * pts[:, 0] + s * pts[:, 1], -s * pts[:, 0] + c * pts[:, 1]))  # the move along +x
     touched = contact_times(disc(radius), along, 1.0, 0.0) <= length + SWEEP_LENGTH  # at 1 m/s, seconds are metres
     if not touched.any():
         return math.inf

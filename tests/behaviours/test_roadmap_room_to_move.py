@@ -1,4 +1,4 @@
-"""A homing's moves judged against hand-set range readings before they start (manual clock).
+"""A homing's sidestep judged against hand-set range readings before they start (manual clock).
 
 The disc of the routine's robot (0.28 m) and the clearance (0.10 m) make 0.38 m between the
 base's centre and a point straight ahead where a move must end; the disc polygon's edges touch
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.roadmap.homing import MIN_STEP, HomingSettings, Look, TargetHoming, _free_end, _step_plan
+from behaviours.roadmap.homing import MIN_STEP, HomingSettings, Look, TargetHoming, _step_plan
 from behaviours.roadmap.room_to_move import straight_reach
 from behaviours.roadmap.routine import Failed
 from behaviours.roadmap.vision import Comparison
@@ -38,13 +38,6 @@ def test_points_beside_the_way_beyond_the_sweep_or_none_hold_nothing():
     assert straight_reach(far, RADIUS, 0.0, 0.25) == math.inf
     assert straight_reach(far, RADIUS, 0.0, 1.0) == pytest.approx(2.0 - 0.38)  # within 1 m + 1 m: it counts
     assert straight_reach(np.zeros((0, 2)), RADIUS, 0.0, 1.0) == math.inf
-
-
-def test_at_the_end_only_what_stands_at_the_goal_cuts_a_drive_short():
-    middle, end = np.array([[1.0, 0.0]]), np.array([[2.3, 0.0]])  # a person half-way, a desk 0.02 m past the goal
-    assert straight_reach(middle, RADIUS, 0.0, 2.0, at_end=True) == math.inf  # the avoidance's to drive round
-    assert straight_reach(np.vstack((middle, end)), RADIUS, 0.0, 2.0, at_end=True) == pytest.approx(2.3 - 0.38)
-    assert straight_reach(middle, RADIUS, 0.0, 2.0) == pytest.approx(1.0 - 0.38)
 
 
 def test_a_point_already_within_the_clearance_ahead_leaves_no_room():
@@ -102,12 +95,3 @@ def test_without_range_sensors_the_step_is_not_judged():
     BehaviourHarness(node, blackboard={"/robot/odometry": Pose2D()})
     assert node.sensed() is None
     assert _step_plan(node, target_ahead(), SETTINGS, 1) == (1, 0.25)
-
-
-def test_a_target_beside_a_desk_is_driven_to_but_not_past():
-    goal = Pose2D(0.5, 0.0, 0.0)
-    head_on = homing_with_ranges({0.0: 0.5 + 0.28 + 0.09})  # the desk 0.09 m beyond the goal's disc, head on
-    (x, y), short = _free_end(head_on, Pose2D(), goal)
-    assert short == pytest.approx(0.01) and (x, y) == pytest.approx((0.49, 0.0))
-    along = homing_with_ranges({90.0: 0.28 + 0.09})  # the same desk beside the way: the drive goes all the way
-    assert _free_end(along, Pose2D(), goal) == ((0.5, 0.0), 0.0)
