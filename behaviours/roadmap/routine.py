@@ -67,7 +67,7 @@ SETTLE = InputPort("settle", float, 0.3, unit="s", minimum=0.0, maximum=5.0,
 ROBOT_RADIUS = InputPort("robot_radius", float, 0.28, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
                          doc="radius of the disc the robot occupies (with a margin)")
 RANGES_IN = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path),
-                      doc="range sensors around the base: a homing judges its moves against them (absent: not judged)")
+                      doc="range sensors around the base: a homing judges its sidesteps by them (absent: not judged)")
 RANGES_MEMORY = 1.0  # s of echoes judged together (a sonar ring fires one transducer at a time)
 ROUTINE_PORTS: tuple[Port, ...] = (CAMERA, CAMERA_OFFSET, SPEED, TURN_SPEED, SETTLE, ODOMETRY, STALLED, FRAMES, HEAD,
                                    COMMAND, HEAD_COMMAND)
