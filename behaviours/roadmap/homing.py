@@ -15,7 +15,11 @@ image after a step of known length". One round here:
    target (best conditioned triangle), driving backwards when that is closer to the current
    heading than driving forwards (no turn over 90 deg), then turn back to the first heading and
    look again: the third image. With a room estimate (``room``), the side whose step ends on
-   free floor goes first; a stall, or no match after the step, tries the other side.
+   free floor goes first; a stall, or no match after the step, tries the other side. With range
+   sensors (``ranges``) the step is judged before it starts (:mod:`behaviours.roadmap.room_to_move`):
+   a side with something in the way gives way to the other side, and with neither free for the
+   whole step, the side with more room is taken with the step shortened to it (at least
+   ``MIN_STEP``; less on both sides: homing fails, "no room to step sideways").
 4. **Triangulate** (:func:`perception.planar.distance_from_third_image`): the two homing rays
    meet where the target image was taken. The camera pose there is that point with the mean of
    the two estimated headings; the robot pose follows from the camera's place on the robot. The
@@ -53,7 +57,8 @@ from behaviours.ports import InputPort, OutputPort, Port, Ref
 from behaviours.registry import register
 from behaviours.roadmap.paths import travel
 from behaviours.roadmap.room import ROOM_IN
-from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.room_to_move import straight_reach
+from behaviours.roadmap.routine import RANGES_IN, ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.scan import MIN_INLIERS_IN
 from behaviours.roadmap.targets import TARGETS_IN
 from behaviours.roadmap.values import HomingResult, TargetView
@@ -74,6 +79,7 @@ MAX_ALIGNS = 2
 MAX_SIDESTEP_FAILURES = 3
 HEADING_AGREEMENT = math.radians(3.0)  # the two images must agree on the target's heading
 PLANNED_BEYOND = 0.5  # m: longer homing drives follow a planned path when the room is known
+MIN_STEP = 0.10  # m: a sidestep shortened to the room the range sensors show is no shorter than this
 
 STEP = InputPort("step", float, 0.25, unit="m", minimum=0.05, maximum=1.0,
                  doc="sidestep for the third image (paper: a step of known length)")
@@ -82,8 +88,9 @@ DONE_DISTANCE = InputPort("done_distance", float, 0.08, unit="m", minimum=0.005,
 MAX_ROUNDS = InputPort("max_rounds", int, 5, minimum=1, maximum=20, literal_only=True,
                        doc="triangulation rounds before homing gives up")
 ROOM_OPTIONAL = InputPort("room", RoomEstimate, None, doc="room estimate (optional): sidestep towards free floor first")
-HOMING_PORTS: tuple[Port, ...] = (STEP, DONE_DISTANCE, MAX_ROUNDS, MIN_INLIERS_IN, ROOM_OPTIONAL, ROBOT_RADIUS)
-REQUIRED_ROOM: tuple[Port, ...] = (STEP, DONE_DISTANCE, MAX_ROUNDS, MIN_INLIERS_IN, ROBOT_RADIUS, ROOM_IN)
+HOMING_PORTS: tuple[Port, ...] = (STEP, DONE_DISTANCE, MAX_ROUNDS, MIN_INLIERS_IN, ROOM_OPTIONAL, ROBOT_RADIUS,
+                                  RANGES_IN)
+REQUIRED_ROOM: tuple[Port, ...] = (STEP, DONE_DISTANCE, MAX_ROUNDS, MIN_INLIERS_IN, ROBOT_RADIUS, ROOM_IN, RANGES_IN)
 """The homing ports of a node that cannot work without the room estimate."""
 
 
@@ -149,8 +156,8 @@ def home(host: RoutineBehaviour, target: TargetView, settings: HomingSettings) -
             aligns += 1
             yield from host.rotate(first.turn, f"facing as {target.name} does")
             continue
-        side = _free_side(host, first, settings, side)
-        second = yield from _sidestep(host, target, first, side, settings)
+        side, length = _step_plan(host, first, settings, _free_side(host, first, settings, side))
+        second = yield from _sidestep(host, target, first, side, length, settings)
         estimate = _triangulate(first, second, host.camera_offset) if second is not None else None
         if estimate is None:
             failures += 1
@@ -209,13 +216,36 @@ def _free_side(host: RoutineBehaviour, first: Look, settings: HomingSettings, si
     return -side if (free[1] and not free[0]) else side
 
 
-def _sidestep(host: RoutineBehaviour, target: TargetView, first: Look, side: int, settings: HomingSettings
-              ) -> Step[Look | None]:
-    """Step sideways, turn back to the first heading and look again (None: stalled or no match)."""
+def _step_plan(host: RoutineBehaviour, first: Look, settings: HomingSettings, side: int) -> tuple[int, float]:
+    """The side and the length of the sidestep, judged against the range sensors before it starts
+    (module docstring, step 3): ``side`` when it has room for the whole step (or nothing is sensed),
+    else the other side when that has, else the side with more room, the step shortened to it."""
+    points = host.sensed()
+    if points is None:
+        return side, settings.step
+    radius = host.get_input(ROBOT_RADIUS)
+    room: dict[int, float] = {}
+    for candidate in (side, -side):
+        turn, sign = _step_motion(first, candidate)
+        room[candidate] = straight_reach(points, radius, turn if sign > 0 else wrap_angle(turn + math.pi),
+                                         settings.step)
+        if room[candidate] >= settings.step:
+            return candidate, settings.step
+    best = max(room, key=lambda c: room[c])
+    if room[best] < MIN_STEP:
+        raise Failed(f"no room to step sideways for the third image ({room[side]:.2f} m and {room[-side]:.2f} m "
+                     f"free, at least {MIN_STEP:g} m needed)")
+    return best, room[best]
+
+
+def _sidestep(host: RoutineBehaviour, target: TargetView, first: Look, side: int, length: float,
+              settings: HomingSettings) -> Step[Look | None]:
+    """Step sideways ``length`` metres, turn back to the first heading and look again (None: stalled
+    or no match)."""
     turn, sign = _step_motion(first, side)
     yield from host.rotate(turn, "turning for the sidestep")
     try:
-        yield from host.drive(sign * settings.step, "sidestep for the third image")
+        yield from host.drive(sign * length, "sidestep for the third image")
     except Failed:
         yield from host.back_off(-sign * 0.1)
         yield from host.turn_to(first.odometry.theta, "turning back")

@@ -22,14 +22,18 @@ import math
 from collections.abc import Generator
 from typing import Any, ClassVar, TypeAlias, TypeVar
 
+import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
+from behaviours.keys import RANGES_KEY
 from behaviours.motion import COMMAND, ODOMETRY, STALLED, Drive, DriveTo, Rotate
 from behaviours.ports import InputPort, OutputPort, Port, Ref
 from drivers.interfaces import STOP, PanTiltCommand, PanTiltState
+from maps.avoidance.memory import ObstacleMemory
 from perception.frame import Frame
 from perception.geometry import Pose2D, wrap_angle
+from perception.ranges import RangeScan
 
 T = TypeVar("T")
 Step: TypeAlias = Generator[None, None, T]
@@ -62,6 +66,9 @@ SETTLE = InputPort("settle", float, 0.3, unit="s", minimum=0.0, maximum=5.0,
                    doc="time at rest before an image is taken")
 ROBOT_RADIUS = InputPort("robot_radius", float, 0.28, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
                          doc="radius of the disc the robot occupies (with a margin)")
+RANGES_IN = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path),
+                      doc="range sensors around the base: a homing judges its sidesteps by them (absent: not judged)")
+RANGES_MEMORY = 1.0  # s of echoes judged together (a sonar ring fires one transducer at a time)
 ROUTINE_PORTS: tuple[Port, ...] = (CAMERA, CAMERA_OFFSET, SPEED, TURN_SPEED, SETTLE, ODOMETRY, STALLED, FRAMES, HEAD,
                                    COMMAND, HEAD_COMMAND)
 """Ports every routine has: its camera, motion limits, the robot's state and its two commands."""
@@ -71,6 +78,7 @@ class RoutineBehaviour(BearingsBehaviour):
     """A leaf whose work is :meth:`routine`, a generator advanced once per tick (module docstring)."""
 
     PORTS: ClassVar[tuple[Port, ...]] = ROUTINE_PORTS
+    RANGES_OPTIONAL = True  # a node with RANGES_IN judges nothing without them (missions.log_check)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -78,6 +86,7 @@ class RoutineBehaviour(BearingsBehaviour):
         self._routine: Step[None] | None = None
         self._motion: BearingsBehaviour | None = None
         self._last_direction = 1.0  # sign of the last drive: a stall is backed away from the other way
+        self._echoes = ObstacleMemory(RANGES_MEMORY)  # with RANGES_IN: the echoes of the last second, odometry frame
 
     def pair(self, port: InputPort[list[float]]) -> tuple[float, float]:
         """A literal ``[x, y]`` port (a position on the robot); ValueError naming the port otherwise."""
@@ -96,6 +105,7 @@ class RoutineBehaviour(BearingsBehaviour):
         self._routine = self.routine()
 
     def update(self) -> Status:
+        self._remember_echoes()
         if self._routine is None:
             self._routine = self.routine()
         try:
@@ -216,6 +226,23 @@ class RoutineBehaviour(BearingsBehaviour):
         """Before a drive: a stall flag still up from an earlier contact is backed away from first."""
         if self.get_input(STALLED, False):
             yield from self.back_off()
+
+    # -- what the range sensors show ------------------------------------------------------------
+    def _remember_echoes(self) -> None:
+        """Every tick, for a node with ``ranges``: add the newest scan to the echoes remembered."""
+        if RANGES_IN.name not in self.inputs:
+            return
+        scan, pose = self.get_input(RANGES_IN, None), self.get_input(ODOMETRY, None)
+        if scan is not None and pose is not None:
+            self._echoes = self._echoes.added(scan.points(), pose, scan.stamp)
+
+    def sensed(self) -> np.ndarray | None:
+        """The echoes of the last :data:`RANGES_MEMORY` seconds around the base now (base frame, N x 2),
+        or None when the node reads no range sensors (no ``ranges`` port, or nothing read yet)."""
+        pose = self.get_input(ODOMETRY, None)
+        if RANGES_IN.name not in self.inputs or not self._echoes.stamps or pose is None:
+            return None
+        return self._echoes.around(pose, self.now())
 
     # -- state and images -------------------------------------------------------------------------
     def pose(self) -> Step[Pose2D]:

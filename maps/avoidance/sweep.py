@@ -103,11 +103,12 @@ class Surroundings:
         """Metres the grown footprint goes along the arc ``(v, w)`` before it touches a point."""
         return free_distance(self.grown, self.points, v, w)
 
-    def grazes(self, v: float, w: float) -> bool:
+    def grazes(self, v: float, w: float, within: float = SWEEP_LENGTH) -> bool:
         """Does the footprint itself reach a point already within the clearance, within the collision
-        monitor's sweep (:data:`perception.collision_monitor.SWEEP_LENGTH`)? The monitor stops such a
-        command, however far off the point is along the arc."""
-        return len(self.near) > 0 and free_distance(self.footprint, self.near, v, w) <= SWEEP_LENGTH
+        monitor's sweep (:data:`perception.collision_monitor.SWEEP_LENGTH`), or ``within`` metres when
+        that is shorter (a motion's goal)? The monitor stops such a command, however far off the point
+        is along the arc."""
+        return len(self.near) > 0 and free_distance(self.footprint, self.near, v, w) <= min(within, SWEEP_LENGTH)
 
     def open(self, v: float, w: float, needed: float, goal: float = math.inf) -> bool:
         """Is the arc free for ``needed`` metres, grazing nothing? With a ``goal`` metres on, where the
@@ -117,7 +118,7 @@ class Surroundings:
         point beyond the goal counts for nothing, not even within the clearance (the monitor's stop,
         should it come, holds the motion all the same)."""
         if needed <= goal - self.margin:
-            return self.free(v, w) >= needed and not self.grazes(v, w)
+            return self.free(v, w) >= needed and not self.grazes(v, w, goal)
         return free_distance(self.footprint, self.points, v, w) >= min(needed, goal) and \
             self.free(v, w) >= goal - self.margin
 

@@ -120,4 +120,5 @@ def test_a_point_within_the_clearance_beyond_the_goal_does_not_block_it():
     near = around((0.28, 0.0))
     assert near.margin == pytest.approx(0.04) and not near.open(0.02, 0.0, 0.01)  # grazed within the sweep
     assert near.open(0.02, 0.0, 0.01, goal=0.05)  # the motion ends 0.03 m short of it
+    assert near.open(0.02, 0.0, 0.01, goal=0.06)  # 0.02 m short, eq. 1's 0.011 m within the goal less the margin
     assert not near.open(0.02, 0.0, 0.01, goal=0.1)  # ... or touches it first
