@@ -34,10 +34,13 @@ disparities) and may be looking sideways:
   drove along); a tall obstacle there would have been seen ahead, from farther away, by cameras
   looking where the robot goes. The goal itself is a border point, next to the unknown: the robot
   stops about a radius before it unless the cameras see beyond it first.
-- **Someone walking towards the robot**: the range sensors' echoes in the lane ahead (within
-  ``robot_radius + lane`` of the line of travel) cap the speed at one from which the robot stops
-  before an obstacle there reaches it, were it walking towards the robot at ``approach`` m/s
-  (:func:`approach_speed`, eq. A). The map and the avoidance judge the way against where things
+- **Someone walking towards the robot**: the echoes of the range sensors that look along the
+  line of travel (whose cone holds the heading: the Pioneer's two front sonars at +-10 degrees)
+  cap the speed at one from which the robot stops before an obstacle there reaches it, were it
+  walking towards the robot at ``approach`` m/s (:func:`approach_speed`, eq. A). Echoes are
+  placed on a sensor's axis, anywhere in its 30-degree cone: the +-30 and +-50 degree sonars put
+  a corridor's walls 0.55 m beside the line of travel, which held the robot to a crawl when they
+  counted. The map and the avoidance judge the way against where things
   are *now*: in a simulated office run the robot drove at 0.36 m/s through a door into the meeting
   room towards a person walking at 0.6 m/s towards it, 0.84 m away; the avoidance's check (the
   braking distance and 0.5 s of travel, 0.57 m) found the way free until 0.4 s before the contact,
@@ -196,8 +199,6 @@ class FollowPath(BearingsBehaviour):
     APPROACH = InputPort("approach", float, 1.0, unit="m/s", minimum=0.0, maximum=3.0, literal_only=True,
                          doc="stop in time for an obstacle in the lane ahead walking towards the robot this fast "
                              "(0: never mind)")
-    LANE = InputPort("lane", float, 0.3, unit="m", minimum=0.0, maximum=2.0, literal_only=True,
-                     doc="echoes within robot_radius + lane of the line of travel are in the lane ahead")
     REACTION = InputPort("reaction", float, 0.2, unit="s", minimum=0.0, maximum=5.0, literal_only=True,
                          doc="from an echo to braking (a tick, the sensors' cycle)")
     RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path), doc=RANGES_KEY.doc)
@@ -206,7 +207,7 @@ class FollowPath(BearingsBehaviour):
         doc="the first point of the path ahead whose disc covers unseen floor (None: none)")
     PORTS = (SPEED, SPEED_LIMIT, TURN_RATE, TOLERANCE, LOOKAHEAD, TURN_IN_PLACE, CHECK_DISTANCE, CLEARANCE,
              ROBOT_RADIUS, MARGIN, PENALTY, BACKOFF, MAX_STALLS, GUARD, STUCK_TIME, UNSEEN_MARGIN, CRAWL, FRONT,
-             APPROACH, LANE, REACTION, RANGES, GOAL, MAP, POSE, STALLED, COMMAND, UNSEEN_AHEAD)
+             APPROACH, REACTION, RANGES, GOAL, MAP, POSE, STALLED, COMMAND, UNSEEN_AHEAD)
     RANGES_OPTIONAL = True  # without range sensors nothing is in the lane: the map's checks alone
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
@@ -313,17 +314,18 @@ class FollowPath(BearingsBehaviour):
         return Status.RUNNING
 
     def _lane_speed(self) -> float:
-        """The speed cap of the echoes in the lane ahead (eq. A; inf without range sensors or echoes there)."""
+        """The speed cap of the echoes straight ahead (eq. A; inf without range sensors or such echoes):
+        those of the sensors whose cone holds the heading, each at its range along its axis."""
         scan = self.get_input(self.RANGES, None)
         approach = self.get_input(self.APPROACH)
         if not isinstance(scan, RangeScan) or approach <= 0.0:
             return math.inf
-        points = scan.points()
-        radius = self.get_input(ROBOT_RADIUS)
-        ahead = points[(points[:, 0] > 0.0) & (np.abs(points[:, 1]) <= radius + self.get_input(self.LANE))]
-        if len(ahead) == 0:
+        gaps = [math.hypot(s.x + r * math.cos(s.heading), s.y + r * math.sin(s.heading))
+                for s, r in zip(scan.sensors, np.asarray(scan.ranges, dtype=float), strict=True)
+                if math.isfinite(r) and abs(wrap_angle(s.heading)) <= s.fov / 2.0]
+        if not gaps:
             return math.inf
-        gap = float(np.min(np.hypot(*ahead.T))) - radius
+        gap = min(gaps) - self.get_input(ROBOT_RADIUS)
         return approach_speed(gap, approach, LINEAR_DECEL, self.get_input(self.REACTION), self.get_input(CLEARANCE))
 
     def _nearest(self, here: np.ndarray) -> int:

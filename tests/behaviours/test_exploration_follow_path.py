@@ -234,12 +234,12 @@ def sonar(front: float, side: float = math.inf) -> RangeScan:
     return RangeScan(sensors, np.array([front, side]), 0.0)
 
 
-def test_an_echo_in_the_lane_ahead_caps_the_speed_one_beside_it_does_not():
+def test_an_echo_straight_ahead_caps_the_speed_one_beside_it_does_not():
     harness = follow(room(), goal_to(3.0))
     harness.write("/robot/ranges", sonar(front=1.35))  # the echo at x 1.45: 1.2 m from the disc (radius 0.25)
     harness.tick()
     assert harness.read("/robot/command").v == pytest.approx(approach_speed(1.2, 1.0, 0.25, 0.2, 0.05))
-    harness.write("/robot/ranges", sonar(front=math.inf, side=0.8))  # a wall beside the lane
+    harness.write("/robot/ranges", sonar(front=math.inf, side=0.8))  # a wall beside: its cone misses the heading
     harness.tick()
     assert harness.read("/robot/command").v == pytest.approx(0.4)
     harness = follow(room(), goal_to(3.0), approach=0.0)
