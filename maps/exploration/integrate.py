@@ -157,6 +157,44 @@ def integrate_observation(
     return reevaluate_interest(out, view.eye, view.heading, params.interest, params.max_range)
 
 
+def clear_rays(
+    m: ExplorationMap, origins: np.ndarray, ends: np.ndarray, params: IntegrationParams = IntegrationParams()
+) -> ExplorationMap:
+    """The map after range echoes: the cells along each ray from ``origins`` to ``ends`` (N x 2,
+    odometry frame), stopped ``see_past`` short of the end, were seen past: their obstacle evidence
+    takes the step ``EvidenceParams.past`` (free at once). A range sensor's echo is the nearest
+    thing in its cone, so nothing stands on its axis before it; the margin keeps the echo's own
+    cells (and its noise) out. Only obstacle cells change: the sonar explores nothing (unknown
+    floor stays unknown, for the cameras to see).
+
+    Why: the cameras see nothing within ~0.66 m of the lens; a person who walked past the robot
+    close by stayed in the map round it as obstacle cells no view could see past, and in one
+    office run every path out of a room corner was blocked by them for 240 s."""
+    f = m.frame
+    starts = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
+    stops = np.asarray(ends, dtype=np.float64).reshape(-1, 2)
+    length = np.hypot(*(stops - starts).T)
+    keep = length > params.see_past
+    if not keep.any():
+        return m
+    starts, stops, length = starts[keep], stops[keep], length[keep]
+    unit = (stops - starts) / length[:, None]
+    steps = [np.arange(0.0, n - params.see_past, f.resolution / 2.0) for n in length]
+    xy = np.concatenate([a + np.outer(s, u) for a, s, u in zip(starts, steps, unit, strict=True)])
+    rows, cols = f.cell_of(xy)
+    inside = f.inside(rows, cols)
+    cells = np.unique(rows[inside] * f.cols + cols[inside])
+    if len(cells) == 0:
+        return m
+    r, c = np.divmod(cells, f.cols)
+    held = m.evidence[r, c] > 0.0
+    if not held.any():
+        return m
+    evidence = m.evidence.copy()
+    evidence[r[held], c[held]] -= params.evidence.past
+    return m.replaced(evidence=evidence)
+
+
 def scan(
     view: CameraView, world: np.ndarray, plan: np.ndarray, params: IntegrationParams
 ) -> tuple[np.ndarray, np.ndarray]:

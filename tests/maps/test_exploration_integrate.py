@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from maps.exploration.grid import Cell, ExplorationMap, mark_traversed
-from maps.exploration.integrate import integrate_observation, integrate_stereo, observe, scan_cells
+from maps.exploration.integrate import clear_rays, integrate_observation, integrate_stereo, observe, scan_cells
 from maps.exploration.interest import Interest, closer_points
 from perception.geometry import Pose2D
 from tests.maps.exploration_maps import SIMPLE, apart, state_at
@@ -165,3 +165,17 @@ def test_the_scan_of_an_observation_draws_again_what_was_explored():
     assert np.array_equal(m.cells == Cell.FREE, drawn & (m.cells != Cell.OBSTACLE))  # the wall's cells are hits
     assert np.array_equal(m.cells, integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points),
                                                     view).cells)
+
+
+def test_an_echo_clears_the_obstacle_cells_before_it_and_explores_nothing():
+    m = ExplorationMap.empty(resolution=0.1)
+    evidence = m.evidence.copy()
+    rows, cols = m.frame.cell_of(np.array([[0.55, 0.05], [1.05, 0.05], [1.75, 0.05], [0.55, 0.55]]))
+    evidence[rows, cols] = 3.5  # a person's cells 0.5 and 1 m ahead, the echo's own, one off the axis
+    evidence[m.frame.cell_of(np.array([[0.25, 0.05]]))] = -1.0  # free floor stays as it was
+    m = clear_rays(m.replaced(evidence=evidence), np.array([[0.0, 0.05]]), np.array([[1.8, 0.05]]))
+    assert state_at(m, 0.55, 0.05) == Cell.FREE and state_at(m, 1.05, 0.05) == Cell.FREE
+    assert state_at(m, 1.75, 0.05) == Cell.OBSTACLE  # within see_past of the echo: its own cell
+    assert state_at(m, 0.55, 0.55) == Cell.OBSTACLE  # off the axis
+    assert m.evidence[m.frame.cell_of(np.array([[0.25, 0.05]]))][0] == pytest.approx(-1.0)
+    assert state_at(m, 1.35, 0.05) == Cell.UNKNOWN  # the sonar explores nothing
