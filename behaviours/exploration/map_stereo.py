@@ -19,6 +19,7 @@ from py_trees.common import Status
 from behaviours.base import BearingsBehaviour
 from behaviours.exploration.drawing import map_drawings
 from behaviours.exploration.ports import CAMERA_POSITION, FRAMES, POSE, PTU_POSITION, ROBOT_RADIUS, xyz
+from behaviours.keys import RANGES_KEY
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.telemetry import Drawing, Figure
@@ -26,9 +27,10 @@ from drivers.interfaces import PanTiltState
 from maps.exploration.codec import pack_cells
 from maps.exploration.grid import Cell, ExplorationMap, borders, mark_traversed
 from maps.exploration.head import StereoHead
-from maps.exploration.integrate import IntegrationParams, integrate_observation, observe
+from maps.exploration.integrate import IntegrationParams, clear_rays, integrate_observation, observe
 from perception.frame import Frame
 from perception.geometry import Pose2D
+from perception.ranges import RangeScan
 from perception.stereo import BELOW_FLOOR, pyramid_points
 
 
@@ -72,10 +74,14 @@ class MapStereo(BearingsBehaviour):
     START_RADIUS = InputPort("start_radius", float, 0.6, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
                              doc="free floor assumed around the start pose")
     PTU = InputPort("ptu", PanTiltState, Ref("/ptu/state"), doc="the pan-tilt angles the frame was taken at")
+    RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path),
+                       doc="range echoes: obstacle cells on a sensor's axis before its echo are cleared")
     MAP_OUT = OutputPort("map", ExplorationMap, "/map/exploration", doc="the exploration map (odometry frame)")
     PORTS = (CAMERA, PERIOD, NUM_DISPARITIES, STEP, LEVELS, MAX_JUMP, RESOLUTION, EXPLORE_RANGE, START_RADIUS,
-             ROBOT_RADIUS, PTU_POSITION, CAMERA_POSITION, FRAMES, PTU, POSE, MAP_OUT)
+             ROBOT_RADIUS, PTU_POSITION, CAMERA_POSITION, FRAMES, PTU, POSE, RANGES, MAP_OUT)
+    RANGES_OPTIONAL = True  # without range sensors the cameras alone clear what they see past
     AREA_EVERY = 2.0  # s between samples of the explored area over time
+    ECHO_REACH = 1.5  # m: echoes clear obstacle cells this near the sensor (where the cameras see least), no farther
     DRAW_EVERY = 10  # integrations between drawings of the map
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
@@ -86,6 +92,7 @@ class MapStereo(BearingsBehaviour):
         self.map: ExplorationMap | None = None
         self.head: StereoHead | None = None
         self._last_stamp: float | None = None
+        self._last_echo: float | None = None
         self._last_integration = -math.inf
         self._last_pose: Pose2D | None = None
         self.path_length = 0.0
@@ -107,6 +114,7 @@ class MapStereo(BearingsBehaviour):
             self.map = mark_traversed(empty, pose, self.get_input(self.START_RADIUS))
         else:
             self.map = mark_traversed(self.map, pose, self.get_input(ROBOT_RADIUS))
+        self._clear_echoes(pose)
         self._integrate(pose)
         now = self.now()
         if not self.area_over_time or now - self.area_over_time[-1][0] >= self.AREA_EVERY:
@@ -114,6 +122,28 @@ class MapStereo(BearingsBehaviour):
         self.set_output(self.MAP_OUT, self.map)
         self.feedback_message = f"{self.map.explored_area:.1f} m^2 explored, {len(self.map.points)} points"
         return Status.RUNNING
+
+    def _clear_echoes(self, pose: Pose2D) -> None:
+        """Obstacle cells on a range sensor's axis before its echo, within ``ECHO_REACH``, are seen past
+        (:func:`maps.exploration.integrate.clear_rays`; new echoes only). Near the robot only: a sonar
+        passes under a table top that the cameras saw, as the collision monitor's sonar does."""
+        scan = self.get_input(self.RANGES, None)
+        if not isinstance(scan, RangeScan) or self.map is None or scan.stamp == self._last_echo:
+            return
+        self._last_echo = scan.stamp
+        ranges = np.asarray(scan.ranges, dtype=float)
+        echo = np.isfinite(ranges)
+        if not echo.any():
+            return
+        sensors = [s for s, e in zip(scan.sensors, echo, strict=True) if e]
+        c, s_ = math.cos(pose.theta), math.sin(pose.theta)
+        x, y, heading = (np.array([getattr(s, a) for s in sensors]) for a in ("x", "y", "heading"))
+        reach = np.minimum(ranges[echo], self.ECHO_REACH + self._params.see_past)  # near the robot only
+        ends_x, ends_y = x + reach * np.cos(heading), y + reach * np.sin(heading)
+        to_odom = np.array([[c, -s_], [s_, c]])
+        origins = np.column_stack((x, y)) @ to_odom.T + (pose.x, pose.y)
+        ends = np.column_stack((ends_x, ends_y)) @ to_odom.T + (pose.x, pose.y)
+        self.map = clear_rays(self.map, origins, ends, self._params)
 
     def _integrate(self, pose: Pose2D) -> None:
         frame = (self.get_input(FRAMES, None) or {}).get(self.get_input(self.CAMERA))

@@ -65,7 +65,10 @@ class SelectGoalPoint(BearingsBehaviour):
     counts, the obstacle cells that close a border a narrower disc reaches are looked at again
     (:func:`maps.exploration.goal.verification_goal`: a VERIFY goal), once per place; a place
     whose look-from point is within ``reach`` of the robot already is looked at by the look-around
-    the FAILURE starts (driving there would end at once, before the cameras turn to it).
+    the FAILURE starts (driving there would end at once, before the cameras turn to it); so is the
+    place of a VERIFY goal once reached (FAILURE, not a strike): the cameras, watching interest
+    edges on the way, need not have looked at it (in the office, 15 trips to look again ended with
+    a doorway's cells where they were, the only look-around far from them).
     The mode, strikes, spent points, avoided targets and verified places outlive re-entries.
     """
 
@@ -155,6 +158,10 @@ class SelectGoalPoint(BearingsBehaviour):
         if reached and goal is not None:
             self.reached += 1
             self._spend(goal)
+            if goal.mode is Mode.VERIFY:  # at the place to look from: the look-around the FAILURE starts looks
+                self._set_goal(None)
+                self.feedback_message = "at a place to look again from: look around at it"
+                return Status.FAILURE
         before = self.switch
         # one travel-cost search from here serves the selection and its second chance (DONE selects nothing)
         travel = None if self.switch.mode is Mode.DONE else goal_travel(m, (pose.x, pose.y), self.params)

@@ -313,9 +313,16 @@ def verification_goal(
     the cells that closed the way; if they were stereo speckle or smear they clear (the evidence is
     log-odds) and the border becomes reachable; if they stay, the caller adds ``blocked`` to
     ``verified``. None: nothing to verify.
+    When no narrow path does (a clump with no gap at all), the same is asked of the path from the
+    robot that crosses the least of what closes the way (known cells its disc cannot pass cost
+    ``CROSSING_COST`` times their length; :func:`maps.exploration.travel.travel_cost`), those within
+    ``look_back`` of a place already verified left closed, so that a wall looked at once sends the
+    next try to the next crossing. The goal is again ``look_back`` before the first cell the robot's
+    disc cannot pass on it: the nearest place it reaches from which to look at what closes the way.
     A choice of ours (the paper ends at the first selection without a reachable border): in
     simulated runs of a flat with doors, a few cells of smear just inside a doorway, never seen
-    again, ended exploration with a room unvisited.
+    again, ended exploration with a room unvisited; in the office, people mapped where they stood
+    closed the corridor with no gap for any disc.
     """
     if params.verify_radius <= 0.0 or params.verify_radius >= params.robot_radius:
         return None
@@ -324,12 +331,32 @@ def verification_goal(
     narrow = candidates(m, robot, replace(params, robot_radius=params.verify_radius, point_clearance=0.0), avoid)
     passable = traversable(m, params.robot_radius)
     done = np.zeros((0, 2)) if verified is None else np.asarray(verified, dtype=np.float64).reshape(-1, 2)
-    promising = np.zeros(len(narrow.border), dtype=bool)  # the nearest border point of a point more than k beyond
-    if len(narrow.border):
-        promising[narrow.nearest[narrow.distance > params.k]] = True
-    order = np.flatnonzero(promising)[np.argsort(narrow.border_cost[promising], kind="stable")][:MAX_VERIFY_TRIES]
+    goal = _look_again(m, narrow, passable, done, params)
+    if goal is not None:
+        return goal
+    # no narrow path: the path that crosses the least of what closes the way (a person's blob across
+    # a corridor, seen standing there, leaves no gap at all); what was looked at already stays closed
+    closed = np.zeros(m.frame.shape, dtype=bool)
+    if len(done):
+        rows, cols = np.nonzero(~passable & (m.cells != Cell.UNKNOWN))
+        near = cKDTree(done).query(m.frame.centre_of(rows, cols))[0] <= params.look_back
+        closed[rows[near], cols[near]] = True
+    travel = travel_cost(m, robot, params.robot_radius, crossing=CROSSING_COST, closed=closed)
+    across = candidates(m, robot, replace(params, point_clearance=0.0), avoid, travel=travel)
+    return _look_again(m, across, passable, done, params)
+
+
+def _look_again(
+    m: ExplorationMap, found: Candidates, passable: np.ndarray, done: np.ndarray, params: GoalParams
+) -> Goal | None:
+    """The VERIFY goal for the closest promising border point of ``found`` whose path is closed for
+    the robot's disc (``passable``) at a place not within ``look_back`` of one ``done``; None: none."""
+    promising = np.zeros(len(found.border), dtype=bool)  # the nearest border point of a point more than k beyond
+    if len(found.border):
+        promising[found.nearest[found.distance > params.k]] = True
+    order = np.flatnonzero(promising)[np.argsort(found.border_cost[promising], kind="stable")][:MAX_VERIFY_TRIES]
     for b in order:
-        path = narrow.travel.path_to((float(narrow.border[b, 0]), float(narrow.border[b, 1])))
+        path = found.travel.path_to((float(found.border[b, 0]), float(found.border[b, 1])))
         rows, cols = m.frame.cell_of(path)
         ok = passable[rows, cols]
         if ok.all() or not ok[0]:  # nothing closes it, or the robot stands where its disc does not fit
@@ -347,3 +374,4 @@ def verification_goal(
 
 
 MAX_VERIFY_TRIES = 200  # border points tried per verification (closest first)
+CROSSING_COST = 10.0  # a metre through what closes the way counts as this many of open floor (verification)

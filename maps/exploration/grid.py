@@ -123,10 +123,21 @@ def read_only(a: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True, slots=True)
 class EvidenceParams:
     """Log-odds steps of the occupancy evidence (Thrun's occupancy grid): a cell is an obstacle
-    while its evidence is positive, explored free while negative, unknown at 0 (never seen)."""
+    while its evidence is positive, explored free while negative, unknown at 0 (never seen).
+
+    Two steps for a cell seen free (the inverse sensor model of
+    :func:`maps.exploration.integrate.integrate_observation`): ``miss`` where the view's free floor
+    ends near the cell (within ``IntegrationParams.see_past`` of where it ends: a wall smeared by
+    drift lies there, so evidence there clears slowly), ``past`` where the view saw the floor well
+    beyond the cell with nothing in between: nothing that stands on the floor can be there now (a
+    wall would have hidden that floor), so whatever was seen there before walked away. ``past``
+    exceeds ``high``: a person who stood in a doorway for a whole look-around is gone from the map at
+    the first view past their place; a wall is never seen past, and stays.
+    """
 
     hit: float = 0.85  # an obstacle point in the cell (once per observation)
-    miss: float = 0.4  # the cell seen as free floor
+    miss: float = 0.4  # the cell seen as free floor, near where the view's free floor ends
+    past: float = 4.0  # the cell seen as free floor, the floor well beyond it seen too (> high: free at once)
     low: float = -2.0  # clamps: a wall seen 5 times outlives ~10 free sightings (drift), ...
     high: float = 3.5  # ...a single false hit is gone after 3
 

@@ -66,7 +66,14 @@ def traversable(m: ExplorationMap, robot_radius: float) -> np.ndarray:
 
 
 def travel_cost(
-    m: ExplorationMap, start: tuple[float, float], robot_radius: float, *, margin: float = 0.0, penalty: float = 0.0
+    m: ExplorationMap,
+    start: tuple[float, float],
+    robot_radius: float,
+    *,
+    margin: float = 0.0,
+    penalty: float = 0.0,
+    crossing: float = math.inf,
+    closed: np.ndarray | None = None,
 ) -> TravelCost:
     """G from ``start`` to every cell: 8-connected Dijkstra over :func:`traversable` cells.
 
@@ -74,13 +81,23 @@ def travel_cost(
     ``robot_radius + margin`` costs up to ``1 + penalty`` times its length (a linear ramp, like a
     costmap's inflation), so that paths keep off obstacles where there is room and G counts the
     care a squeeze takes. Without (the default), G is the path length in metres.
+
+    With a finite ``crossing``, the *known* cells the robot's disc cannot pass (obstacle cells, and
+    free cells too near them) are traversed as well, a step into one costing ``crossing`` times
+    the length (never the unknown, nor the ``closed`` cells, a bool grid): the path that crosses
+    the least of what closes the way, for looking at it again
+    (:func:`maps.exploration.goal.verification_goal`). It is no path to drive.
     """
     frame = m.frame
     cost = np.full(frame.shape, np.inf)
     previous = np.full(frame.shape, -1, dtype=np.int64)
     room = m.clearance
     ok = ((m.cells == Cell.FREE) & (room > robot_radius)) | m.visited
+    across = np.zeros(frame.shape, dtype=bool)
+    if math.isfinite(crossing):
+        across = (m.cells != Cell.UNKNOWN) & ~ok & (True if closed is None else ~closed)
     source = _snap(ok, frame, start, robot_radius)
+    ok = ok | across
     if source is None:
         return TravelCost(frame, read_only(cost), read_only(previous))
     (sr, sc), snap = source
@@ -91,6 +108,7 @@ def travel_cost(
     weight = np.ones(sub.shape)
     if margin > 0.0:
         weight += penalty * np.clip((robot_radius + margin - room[box]) / margin, 0.0, 1.0)
+    weight[across[box]] = crossing
     node = np.full(sub.shape, -1, dtype=np.int64)
     node[sub] = np.arange(np.count_nonzero(sub))
     graph = _grid_graph(sub, node, weight, frame.resolution)

@@ -8,13 +8,14 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.exploration.follow_path import FollowPath, disc_cells
+from behaviours.exploration.follow_path import FollowPath, approach_speed, disc_cells
 from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP
 from maps.exploration.goal import Goal, Mode
 from maps.exploration.grid import Cell, ExplorationMap, GridFrame
 from perception.geometry import Pose2D
+from perception.ranges import RangeScan, RangeSensor
 
 FRAME = GridFrame(-1.0, -1.0, 0.05, 40, 100)  # x -1..4, y -1..1
 
@@ -215,3 +216,33 @@ def test_the_report_keeps_its_shape_and_the_path_is_drawn_when_it_changes():
     assert node.replans == 1 and [d.entity for d in node.drawings()] == ["odometry_frame/exploration/followed"]
     assert report_sections(node) == {"exploration": {"stalls": 0, "replans": 1, "stuck": 0, "safety_stops": 0,
                                                      "blind_stops": 0}}
+
+
+def test_approach_speed_stops_in_time_for_someone_walking_towards_the_robot():
+    # hand: gap 1 m, 1 m/s, 0.25 m/s^2, 0.2 s, 0.05 m: room 0.75, b = 4.2, v = 0.25 (sqrt(4.2^2 + 6) - 4.2)
+    v = approach_speed(1.0, 1.0, 0.25, 0.2, 0.05)
+    assert v == pytest.approx(0.25 * (math.sqrt(23.64) - 4.2))
+    assert v * v / 0.5 + (v + 1.0) * 0.2 + v / 0.25 == pytest.approx(0.95)  # eq. A with equality
+    assert approach_speed(1.0, 0.0, 0.25, 0.0, 0.0) == pytest.approx(math.sqrt(2 * 0.25 * 1.0))  # still: braking only
+    assert approach_speed(0.2, 1.0, 0.25, 0.2, 0.05) == 0.0  # too late to move on at all
+    assert approach_speed(3.0, 1.0, 0.25, 0.2, 0.05) > 0.4
+
+
+def sonar(front: float, side: float = math.inf) -> RangeScan:
+    """A sonar looking straight ahead and one at 60 degrees to the left (readings in m; inf: no echo)."""
+    sensors = (RangeSensor(0.1, 0.0, 0.0), RangeSensor(0.1, 0.1, math.radians(60.0)))
+    return RangeScan(sensors, np.array([front, side]), 0.0)
+
+
+def test_an_echo_straight_ahead_caps_the_speed_one_beside_it_does_not():
+    harness = follow(room(), goal_to(3.0))
+    harness.write("/robot/ranges", sonar(front=1.35))  # the echo at x 1.45: 1.2 m from the disc (radius 0.25)
+    harness.tick()
+    assert harness.read("/robot/command").v == pytest.approx(approach_speed(1.2, 1.0, 0.25, 0.2, 0.05))
+    harness.write("/robot/ranges", sonar(front=math.inf, side=0.8))  # a wall beside: its cone misses the heading
+    harness.tick()
+    assert harness.read("/robot/command").v == pytest.approx(0.4)
+    harness = follow(room(), goal_to(3.0), approach=0.0)
+    harness.write("/robot/ranges", sonar(front=1.35))
+    harness.tick()
+    assert harness.read("/robot/command").v == pytest.approx(0.4)

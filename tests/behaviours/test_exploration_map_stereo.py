@@ -15,6 +15,7 @@ from drivers.sim.simulation import Simulation
 from maps.exploration.codec import unpack_cells
 from maps.exploration.grid import Cell
 from perception.geometry import Pose2D
+from perception.ranges import RangeScan, RangeSensor
 
 MAP, POSE = "/map/exploration", "/robot/pose"
 
@@ -104,3 +105,18 @@ def test_the_map_is_drawn_on_the_first_integration_and_then_every_tenth(stereo_f
     harness.clock.advance(0.5)
     harness.tick()
     assert len(node.scans) == 2 and list(node.drawings()) == []  # the second integration: not drawn
+
+
+def test_range_echoes_clear_obstacle_cells_near_the_robot():
+    harness = BehaviourHarness(MapStereo(start_radius=0.3, odometry="{/robot/pose}"))
+    harness.write(POSE, Pose2D(0.0, 0.0, math.pi / 2))  # facing +y
+    harness.tick()
+    m = harness.read(MAP)
+    evidence = m.evidence.copy()
+    near, far = m.frame.cell_of(np.array([[0.0, 0.8]])), m.frame.cell_of(np.array([[0.0, 2.2]]))
+    evidence[near], evidence[far] = 3.5, 3.5  # ahead of the robot: 0.8 m and 2.2 m (beyond ECHO_REACH)
+    harness.behaviour.map = m.replaced(evidence=evidence)
+    harness.write("/robot/ranges", RangeScan((RangeSensor(0.1, 0.0, 0.0),), np.array([3.0]), 1.0))
+    harness.tick()
+    m = harness.read(MAP)
+    assert m.cell_state(np.array([[0.0, 0.8], [0.0, 2.2]])).tolist() == [Cell.FREE, Cell.OBSTACLE]

@@ -169,9 +169,12 @@ def test_a_border_closed_by_a_clump_is_looked_at_again_before_done():
     goal = harness.read(GOAL)
     assert goal.mode is Mode.VERIFY and goal.blocked is not None and goal.blocked[0] > 2.5
     assert goal.path[-1] == pytest.approx(goal.target) and goal.target[0] < goal.blocked[0] - 0.9
-    harness.write(POSE, Pose2D(*goal.target))  # arrived; the clump is still there
-    assert harness.tick() == Status.FAILURE  # the place is verified; nothing else to look at: a strike
-    assert harness.behaviour.verified == [goal.blocked] and harness.behaviour.switch.strikes == 1
+    harness.write(POSE, Pose2D(*goal.target))  # arrived: look around from there (a FAILURE, not a strike)
+    assert harness.tick() == Status.FAILURE and "look around at it" in harness.behaviour.feedback_message
+    assert harness.read(GOAL) is None
+    assert harness.behaviour.verified == [goal.blocked] and harness.behaviour.switch.strikes == 0
+    assert harness.tick() == Status.FAILURE  # the clump is still there; nothing else to look at: a strike
+    assert harness.behaviour.switch.strikes == 1
     assert harness.tick() == Status.SUCCESS
     assert report_sections(harness.behaviour)["exploration"]["verifications"] == 1
 

@@ -248,3 +248,24 @@ def test_nothing_to_verify_without_the_clump_or_once_verified_or_when_off():
     assert verification_goal(m, robot, VERIFY, avoid=np.array([[3.45, y] for y in (0.75, 1.05, 1.35)])) is None
     assert verification_goal(m, robot, GoalParams(robot_radius=0.26, min_frontier=0.1)) is None
     assert verification_goal(doorway(speckle=True, points=False), robot, VERIFY) is None  # nothing seen beyond
+
+
+def closed_doorway() -> ExplorationMap:
+    """:func:`doorway` with a blob across the whole passage (x 3.2-3.4): no gap for any disc."""
+    m = doorway(speckle=False)
+    cells = m.cells.copy()
+    cells[7:15, 33:35] = Cell.OBSTACLE
+    return ExplorationMap.from_cells(m.frame, cells, points=m.points)
+
+
+def test_a_border_closed_with_no_gap_is_looked_at_from_the_nearest_place_the_robot_reaches():
+    m, robot = closed_doorway(), (0.55, 1.05)
+    assert select_goal(ModeSwitch(), m, robot, VERIFY)[1] is None
+    goal = verification_goal(m, robot, VERIFY)
+    assert goal is not None and goal.mode is Mode.VERIFY and goal.blocked is not None
+    assert 2.7 <= goal.blocked[0] <= 3.1  # where the robot's disc first stops fitting: the door
+    rows, cols = m.frame.cell_of(np.array([goal.target]))
+    assert traversable(m, 0.26)[rows[0], cols[0]]
+    assert 1.6 <= goal.target[0] <= 2.2 and abs(goal.target[1] - 1.05) <= 0.3  # 1 m of path before, facing it
+    # looked at once and still there: nothing else closes a border, nothing left to verify
+    assert verification_goal(m, robot, VERIFY, verified=np.array([goal.blocked])) is None

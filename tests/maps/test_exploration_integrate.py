@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from maps.exploration.grid import Cell, ExplorationMap, mark_traversed
-from maps.exploration.integrate import integrate_observation, integrate_stereo, observe, scan_cells
+from maps.exploration.integrate import clear_rays, integrate_observation, integrate_stereo, observe, scan_cells
 from maps.exploration.interest import Interest, closer_points
 from perception.geometry import Pose2D
 from tests.maps.exploration_maps import SIMPLE, apart, state_at
@@ -61,18 +61,53 @@ def test_observations_use_the_odometry_pose_and_pan():
     assert m.points[:, 2] == pytest.approx(np.ones(len(m.points)))
 
 
-def test_obstacle_evidence_clears_when_the_floor_is_seen_there_again():
+def floor_patch(x_far: float, half_width: float = 0.3) -> np.ndarray:
+    """Camera-frame points of the floor from 1 m ahead out to ``x_far`` (lens 1 m up: z = -1)."""
+    xs, ys = np.meshgrid(np.arange(1.0, x_far + 1e-9, 0.05), np.linspace(-half_width, half_width, 13))
+    return np.column_stack((xs.ravel(), ys.ravel(), np.full(xs.size, -1.0)))
+
+
+def test_obstacle_evidence_near_the_end_of_the_seen_floor_clears_slowly():
+    # a wall smeared by drift: the floor seen again up to 0.15 m beyond its cell (less than see_past)
     points = wall_observation()
     view = SIMPLE.view(Pose2D(), 0.0, 0.0)
     m = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points), view)
     assert m.evidence[m.frame.cell_of(np.array([[2.05, 0.05]]))][0] == pytest.approx(0.85)
-    xs, ys = np.meshgrid(np.linspace(1.0, 2.9, 39), np.linspace(-0.3, 0.3, 13))
-    floor = np.column_stack((xs.ravel(), ys.ravel(), np.full(xs.size, -1.0)))
+    floor = floor_patch(2.2)
     for sightings, expected in ((1, Cell.OBSTACLE), (2, Cell.OBSTACLE), (3, Cell.FREE)):  # 0.85 - n * 0.4
         m = integrate_stereo(m, floor, apart(floor), view)
         assert state_at(m, 2.05, 0.05) == expected, sightings
-    assert state_at(m, 2.55, 0.05) == Cell.FREE
     assert state_at(m, 2.05, 0.55) == Cell.OBSTACLE  # outside the floor patch: still the wall
+
+
+def test_a_person_seen_and_then_seen_past_is_gone_at_once():
+    # a person 2 m ahead, seen in 10 views (a look-around while they wait): evidence at its clamp
+    person = np.array([[2.05, y, z] for y in (-0.15, -0.05, 0.05, 0.15) for z in (-0.5, 0.0, 0.5)])
+    view = SIMPLE.view(Pose2D(), 0.0, 0.0)
+    m = ExplorationMap.empty(resolution=0.1)
+    for _ in range(10):
+        m = integrate_stereo(m, person, apart(person), view)
+    assert m.evidence[m.frame.cell_of(np.array([[2.05, 0.05]]))][0] == pytest.approx(3.5)
+    floor = floor_patch(2.9)  # they walked away: the floor there and 0.85 m beyond it is seen
+    m = integrate_stereo(m, floor, apart(floor), view)
+    assert state_at(m, 2.05, 0.05) == Cell.FREE and state_at(m, 2.05, -0.15) == Cell.FREE
+    assert state_at(m, 2.85, 0.05) == Cell.FREE
+
+
+def test_a_wall_seen_once_and_never_seen_past_stays():
+    points = wall_observation()
+    ahead = SIMPLE.view(Pose2D(), 0.0, 0.0)
+    m = integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points), ahead)
+    # views elsewhere (the floor to the left, seen past) and the floor up to the wall ahead again
+    left = SIMPLE.view(Pose2D(), math.pi / 2, 0.0)
+    floor = floor_patch(2.9)
+    short = floor_patch(1.95)  # ends in front of the wall
+    for _ in range(20):
+        m = integrate_stereo(m, floor, apart(floor), left)
+        m = integrate_stereo(m, short, apart(short), ahead)
+    assert state_at(m, 2.05, 0.05) == Cell.OBSTACLE
+    assert state_at(m, 2.05, 1.55) == Cell.OBSTACLE
+    assert state_at(m, 1.45, 0.05) == Cell.FREE and state_at(m, 0.05, 2.45) == Cell.FREE
 
 
 def test_the_robots_disc_is_free_whatever_was_seen_there():
@@ -130,3 +165,17 @@ def test_the_scan_of_an_observation_draws_again_what_was_explored():
     assert np.array_equal(m.cells == Cell.FREE, drawn & (m.cells != Cell.OBSTACLE))  # the wall's cells are hits
     assert np.array_equal(m.cells, integrate_stereo(ExplorationMap.empty(resolution=0.1), points, apart(points),
                                                     view).cells)
+
+
+def test_an_echo_clears_the_obstacle_cells_before_it_and_explores_nothing():
+    m = ExplorationMap.empty(resolution=0.1)
+    evidence = m.evidence.copy()
+    rows, cols = m.frame.cell_of(np.array([[0.55, 0.05], [1.05, 0.05], [1.75, 0.05], [0.55, 0.55]]))
+    evidence[rows, cols] = 3.5  # a person's cells 0.5 and 1 m ahead, the echo's own, one off the axis
+    evidence[m.frame.cell_of(np.array([[0.25, 0.05]]))] = -1.0  # free floor stays as it was
+    m = clear_rays(m.replaced(evidence=evidence), np.array([[0.0, 0.05]]), np.array([[1.8, 0.05]]))
+    assert state_at(m, 0.55, 0.05) == Cell.FREE and state_at(m, 1.05, 0.05) == Cell.FREE
+    assert state_at(m, 1.75, 0.05) == Cell.OBSTACLE  # within see_past of the echo: its own cell
+    assert state_at(m, 0.55, 0.55) == Cell.OBSTACLE  # off the axis
+    assert m.evidence[m.frame.cell_of(np.array([[0.25, 0.05]]))][0] == pytest.approx(-1.0)
+    assert state_at(m, 1.35, 0.05) == Cell.UNKNOWN  # the sonar explores nothing

@@ -78,3 +78,19 @@ def test_traversable_cells_have_clearance_beyond_the_radius_or_are_on_the_trail(
     trail = mark_traversed(m, Pose2D(0.15, 0.05), 0.0, chunk_m=0.1)
     assert trail.visited[trail.frame.cell_of(np.array([[0.15, 0.05]]))][0]
     assert traversable(trail, 0.25)[trail.frame.cell_of(np.array([[0.15, 0.05]]))][0]  # it fitted there
+
+
+def test_crossing_goes_through_the_least_of_what_closes_the_way_and_never_the_unknown():
+    cells = np.full((5, 12), Cell.FREE, dtype=np.uint8)  # 0.1 m cells, a strip 1.2 m long
+    cells[:, 5] = Cell.OBSTACLE  # a wall across it
+    cells[0, 8] = Cell.UNKNOWN
+    m = grid_map(cells)
+    assert not np.isfinite(travel_cost(m, (0.25, 0.25), 0.0).at(np.array([[1.05, 0.25]]))[0])
+    across = travel_cost(m, (0.25, 0.25), 0.0, crossing=10.0)
+    # hand: 8 steps of 0.1 m; the two into and out of the wall cost the mean weight (1 + 10) / 2 each
+    assert across.at(np.array([[1.05, 0.25]]))[0] == pytest.approx(6 * 0.1 + 2 * 0.1 * 5.5)
+    assert not np.isfinite(across.at(np.array([[0.85, 0.05]]))[0])  # the unknown is never crossed
+    closed = np.zeros(m.frame.shape, dtype=bool)
+    closed[:, 5] = True
+    assert not np.isfinite(travel_cost(m, (0.25, 0.25), 0.0, crossing=10.0, closed=closed).at(
+        np.array([[1.05, 0.25]]))[0])
