@@ -208,6 +208,16 @@ OBSERVATION_IN = InputPort("observation", Observation, Ref("/perception/observat
                            doc="the landmarks seen now (Perceive)")
 
 
+def sees(tree: LandmarkTree, index: int, observation: Observation, min_matches: int, rng: np.random.Generator
+         ) -> bool:
+    """Does ``observation`` match viewframe ``index`` well enough to home to it (``FollowRoute``'s rule:
+    enough matches, and a valid Z-infinity rotation)? What a skip or a search needs to take it as the target."""
+    matches = tree.match(index, observation)
+    if len(matches) < lost_threshold(len(tree.viewframe(index)), min_matches):
+        return False
+    return zinf_motion(matches.ref, matches.cur, rng).motion.rotation_ok
+
+
 def _counted_as(estimate: RouteEstimate) -> str:
     """The rule an estimate is counted under: its own when it found a rotation."""
     if estimate.status == LOST:

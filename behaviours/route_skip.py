@@ -26,20 +26,8 @@ from behaviours.base import BearingsBehaviour
 from behaviours.landmark_tree import LTMAP_IN
 from behaviours.ports import InputPort, OutputPort
 from behaviours.registry import register
-from behaviours.route import MIN_MATCHES, OBSERVATION_IN, PROGRESS_IN, PROGRESS_KEY, RouteProgress
+from behaviours.route import MIN_MATCHES, OBSERVATION_IN, PROGRESS_IN, PROGRESS_KEY, RouteProgress, sees
 from behaviours.telemetry import Event, Figure
-from maps.ltmap.tree import LandmarkTree
-from perception.observation import Observation
-from perception.viewframe_motion import lost_threshold, zinf_motion
-
-
-def sees(tree: LandmarkTree, index: int, observation: Observation, min_matches: int, rng: np.random.Generator
-         ) -> bool:
-    """Does ``observation`` match viewframe ``index`` well enough to home to it (``FollowRoute``'s rule)?"""
-    matches = tree.match(index, observation)
-    if len(matches) < lost_threshold(len(tree.viewframe(index)), min_matches):
-        return False
-    return zinf_motion(matches.ref, matches.cur, rng).motion.rotation_ok
 
 
 @register

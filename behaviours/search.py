@@ -32,11 +32,10 @@ from behaviours.landmark_tree import LTMAP_IN
 from behaviours.motion import COMMAND, ODOMETRY, STALLED
 from behaviours.ports import InputPort, OutputPort
 from behaviours.registry import register
-from behaviours.route import MIN_MATCHES, OBSERVATION_IN, PROGRESS_IN, PROGRESS_KEY, RouteProgress
+from behaviours.route import MIN_MATCHES, OBSERVATION_IN, PROGRESS_IN, PROGRESS_KEY, RouteProgress, sees
 from behaviours.telemetry import Drawing, Figure, Lines
 from drivers.interfaces import STOP, VelocityCommand
 from perception.geometry import Pose2D, wrap_angle
-from perception.viewframe_motion import lost_threshold, zinf_motion
 
 
 def lying_eight(width: float, points: int = 64) -> np.ndarray:
@@ -131,10 +130,7 @@ class SearchPattern(BearingsBehaviour):
         steps = (*range(window + 1), *range(-1, -behind - 1, -1))  # ahead first, then back along the route
         candidates = [progress.target + progress.direction * k for k in steps]
         for index in (c for c in candidates if 0 <= c <= last):
-            matches = tree.match(index, observation)
-            if len(matches) < lost_threshold(len(tree.viewframe(index)), self.get_input(MIN_MATCHES)):
-                continue
-            if zinf_motion(matches.ref, matches.cur, self._rng).motion.rotation_ok:
+            if sees(tree, index, observation, self.get_input(MIN_MATCHES), self._rng):
                 self.set_output(self.FOUND, progress.retargeted(index, self.now()))
                 self.found_again += 1
                 self.feedback_message = f"the trail is found again at viewframe {index}"
