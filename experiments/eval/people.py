@@ -157,19 +157,19 @@ def on_ways(world: World, ways: Sequence[np.ndarray], count: int, seed: int, *,
     from ``seed``: a point uniform along all the ways together, then standing or crossing."""
     rng = np.random.default_rng([seed, count, 0x9E09])
     placer = _Placer(world, keep_clear)
-    segments = [(a, b, way, float(np.hypot(*np.diff(way[: i + 1], axis=0).T).sum()))
-                for way in ways for i, (a, b) in enumerate(zip(way[:-1], way[1:], strict=True))
-                if np.hypot(*(b - a)) > 0]  # (start, end, its way, the way's length before it)
+    arcs = [np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(way, axis=0).T)))) for way in ways]  # arc lengths
+    segments = [(way[i], way[i + 1], w, i) for w, way in enumerate(ways) for i in range(len(way) - 1)
+                if arcs[w][i + 1] > arcs[w][i]]  # (start, end, which way, which of its segments)
     if not segments:
         return []
-    lengths = np.array([np.hypot(*(b - a)) for a, b, _, _ in segments])
+    lengths = np.array([arcs[w][i + 1] - arcs[w][i] for _, _, w, i in segments])
     for _ in range(count):
         for _ in range(DRAWS):
             k = int(rng.choice(len(segments), p=lengths / lengths.sum()))
-            a, b, way, start = segments[k]
+            a, b, w, i = segments[k]
             u = rng.uniform()
             p = a + (b - a) * u
-            around = _on_way(way, start + u * lengths[k], (-PAST, PAST))
+            around = _on_way(ways[w], arcs[w], arcs[w][i] + u * lengths[k], (-PAST, PAST))
             walker = _standing_or_crossing(placer, p, (b - a) / lengths[k], around, rng)
             if walker is not None and placer.keeps_ways(walker):
                 placer.placed.append(walker)
@@ -179,12 +179,11 @@ def on_ways(world: World, ways: Sequence[np.ndarray], count: int, seed: int, *,
     return placer.placed
 
 
-def _on_way(way: np.ndarray, s: float, offsets: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
-    """The points of the polyline ``way`` at arc lengths ``s`` plus each of the two ``offsets``
-    (clipped to its ends)."""
-    cumulative = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(way, axis=0).T))))
-    at = np.clip(s + np.asarray(offsets, dtype=float), 0.0, cumulative[-1])
-    points = np.column_stack((np.interp(at, cumulative, way[:, 0]), np.interp(at, cumulative, way[:, 1])))
+def _on_way(way: np.ndarray, arc: np.ndarray, s: float, offsets: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """The points of the polyline ``way`` (``arc``: the arc length at each of its points) at arc
+    lengths ``s`` plus each of the two ``offsets`` (clipped to its ends)."""
+    at = np.clip(s + np.asarray(offsets, dtype=float), 0.0, arc[-1])
+    points = np.column_stack((np.interp(at, arc, way[:, 0]), np.interp(at, arc, way[:, 1])))
     return points[0], points[1]
 
 
