@@ -8,7 +8,11 @@ observation is matched against the target viewframe and the next ones along the 
 (``window``), then the ones before it (``behind``): the first with enough matches (the same rule
 as ``FollowRoute``'s) and a valid Z-infinity rotation becomes the target, and the node succeeds so
 the mission resumes following (in a ``RecoveryNode``). FAILURE after ``eights`` eights without the
-trail, or when stalled.
+trail, or when stalled, and at once when more than ``searches`` searches have started since the
+route last moved on (its target went farther along the route than at any search before): ``follow_route``'s
+``retries`` count the trails lost and found again in one stretch of the route, not over the whole
+route, so a long route among people, losing and finding the trail now and then, is not failed for
+losses it recovered from long ago; a robot losing the trail again and again in one place is.
 
 With ``behind``, viewframes already passed count too (a departure: the paper searches for the one it lost). A
 robot that lost the trail getting round people has often been pushed back or aside, nearer the
@@ -63,8 +67,11 @@ class SearchPattern(BearingsBehaviour):
     WINDOW = InputPort("window", int, 2, minimum=0, doc="viewframes past the target also searched for")
     BEHIND = InputPort("behind", int, 0, minimum=0,
                        doc="viewframes before the target (already passed) searched for after those ahead")
+    SEARCHES = InputPort("searches", int, 0, minimum=0,
+                         doc="searches allowed since the route last moved on (its target advanced); one more fails at "
+                             "once: the trail lost and found again this often in one stretch; 0: no limit")
     FOUND = OutputPort("found", type=RouteProgress, key=PROGRESS_KEY, doc="the progress with the viewframe found")
-    PORTS = (WIDTH, SPEED, EIGHTS, WINDOW, BEHIND, MIN_MATCHES,
+    PORTS = (WIDTH, SPEED, EIGHTS, WINDOW, BEHIND, SEARCHES, MIN_MATCHES,
              LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, ODOMETRY, STALLED, COMMAND, FOUND)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
@@ -76,6 +83,8 @@ class SearchPattern(BearingsBehaviour):
         self._logged_origin: Pose2D | None = None
         self._last_theta, self._turned = 0.0, 0.0
         self._stamp: float | None = None
+        self._farthest: int | None = None  # the farthest target along the route a search started from
+        self._since = 0  # searches started since the target last went farther
         self._reset()
 
     def _reset(self) -> None:
@@ -84,6 +93,12 @@ class SearchPattern(BearingsBehaviour):
     def initialise(self) -> None:
         self._reset()
         self.recoveries += 1
+        progress = self.get_input(PROGRESS_IN, None)
+        if progress is not None:
+            reach = progress.target * progress.direction
+            if self._farthest is None or reach > self._farthest:
+                self._farthest, self._since = reach, 0
+        self._since += 1
 
     def update(self) -> Status:
         pose = self.get_input(ODOMETRY, None)
@@ -93,6 +108,10 @@ class SearchPattern(BearingsBehaviour):
         if pose is None:
             self.feedback_message = "waiting for odometry"
             return self._stop(Status.RUNNING)
+        searches = self.get_input(self.SEARCHES)
+        if searches and self._since > searches:
+            self.feedback_message = f"the trail was lost {self._since} times since the route last moved on"
+            return self._stop(Status.FAILURE)
         if self._found():
             return self._stop(Status.SUCCESS)
         if self._origin is None:

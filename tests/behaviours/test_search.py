@@ -87,3 +87,22 @@ def test_search_finds_a_viewframe_already_passed_only_within_behind(behind, foun
         assert status == Status.RUNNING and harness.read("/map/route_progress").target == 9
     else:
         assert status == Status.SUCCESS and harness.read("/map/route_progress").target == found
+
+
+def test_search_fails_at_once_when_the_trail_was_lost_too_often_without_the_route_moving_on():
+    # searches=2: a third search from the same target fails without driving; one from farther on starts afresh
+    progress = RouteProgress(1, 3, TREE.viewframe_count, 0.0)
+    node = SearchPattern(searches=2)
+    harness = BehaviourHarness(node, blackboard={"/map/ltmap": TREE, "/map/route_progress": progress})
+    base = IdealBase(harness, Pose2D(20.0, 20.0, 0.0))  # far from the route: nothing matches
+    step = blind(harness, base)
+    for _ in range(2):
+        assert harness.tick() == Status.RUNNING and harness.read("/robot/command").v > 0.0
+        step(harness)
+        node.stop(Status.INVALID)  # the recovery node starts the task again: the trail found and lost again
+    assert harness.tick() == Status.FAILURE and "lost 3 times" in node.feedback_message
+    assert harness.read("/robot/command").v == 0.0
+    node.stop(Status.INVALID)
+    harness.write("/map/route_progress", progress.retargeted(5, 1.0))  # the route moved on: counting starts again
+    assert harness.tick() == Status.RUNNING and harness.read("/robot/command").v > 0.0
+
