@@ -6,7 +6,11 @@ transducers from ARIA's parameter files). Like the real one it fires in turn: in
 together, so each transducer is refreshed every 0.32 s and a reading can be that old; a transducer
 that has not fired yet reads ``nan``. A firing casts :data:`RAYS_PER_CONE` rays across the
 transducer's cone and hears the nearest wall, box face, pillar or person they meet (at any height:
-everything in a world stands on the floor and is taller than a sonar); Gaussian noise of
+everything in a world stands on the floor and is taller than a sonar), or the open end of a wall
+anywhere in the cone, whichever is nearer: a wall is drawn as a line, but a real one is about
+:data:`WALL_THICKNESS` thick, and its end (a door jamb) is an edge a sonar hears wherever it is in
+the beam, where rays 7.5 degrees apart pass either side of it, or along a wall seen end-on
+(:func:`wall_ends_in_cones`). Gaussian noise of
 ``noise`` metres is added, an echo beyond ``max_range`` is ``inf``, nearer than the transducer's
 ``min_range`` reads ``min_range``, and with probability ``miss_probability`` the firing hears
 nothing (``inf``: a specular reflection, a soft surface). Firings are computed when the ring is
@@ -37,7 +41,23 @@ from perception.ranges import Bumper, RangeScan, RangeSensor
 
 FIRING_PERIOD_S = 0.04  # s: one transducer per ring every 40 ms (25 Hz, the Pioneer 3's rate)
 RAYS_PER_CONE = 5
+WALL_THICKNESS = 0.1  # m: a wall drawn as a line, where a sonar meets its open end
 CONTACT_M = 0.01  # m: a bumper closes this near (the simulator stops the robot within 1 mm of contact)
+
+
+def wall_ends_in_cones(origins: np.ndarray, headings: np.ndarray, fov: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Range from each transducer (``origins`` N x 2, world ``headings`` and whole cone ``fov``, rad) to
+    the nearest wall end's face (a disc :data:`WALL_THICKNESS` across at each of ``ends``, E x 2) any
+    part of which is in its cone; inf: none."""
+    if len(ends) == 0 or len(origins) == 0:
+        return np.full(len(origins), np.inf)
+    radius = WALL_THICKNESS / 2.0
+    offset = ends[None, :, :] - origins[:, None, :]  # (N, E, 2)
+    distance = np.hypot(offset[..., 0], offset[..., 1])
+    off_axis = np.abs(np.angle(np.exp(1j * (np.arctan2(offset[..., 1], offset[..., 0]) - headings[:, None]))))
+    half = np.arcsin(np.clip(radius / np.maximum(distance, radius), 0.0, 1.0))  # half the disc's width seen
+    inside = off_axis <= fov[:, None] / 2.0 + half
+    return np.where(inside, np.maximum(distance - radius, 0.0), np.inf).min(axis=1)
 
 
 class SimRanges:
@@ -86,6 +106,9 @@ class SimRanges:
         dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1).reshape(-1, 2)
         true = self.scene.cast_rays(np.repeat(origins, RAYS_PER_CONE, axis=0), dirs)
         true = true.reshape(-1, RAYS_PER_CONE).min(axis=1)
+        headings = np.array([self.sensors[i].heading for i in which]) + pose.theta
+        fov = np.array([self.sensors[i].fov for i in which])
+        true = np.minimum(true, wall_ends_in_cones(origins, headings, fov, self.scene.wall_ends))
         noise = self.rng.normal(0.0, 1.0, size=len(which)) * self.spec.noise
         missed = self.rng.random(len(which)) < self.spec.miss_probability
         for k, i in enumerate(which):

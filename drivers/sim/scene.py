@@ -78,6 +78,9 @@ class Scene:
         self.circle_xy = np.asarray(centres, dtype=float).reshape(-1, 2)
         self.circle_r = np.asarray([p.radius for p in rounds], dtype=float)
         self._pillar_index = np.arange(n_segments, self.n_surfaces)
+        ends = [p for wall in world.walls if wall.points[0] != wall.points[-1]
+                for p in (wall.points[0], wall.points[-1])]
+        self.wall_ends = np.asarray(ends, dtype=float).reshape(-1, 2)  # open ends of walls: door jambs, wall ends
         self.landmark_ids = np.asarray([lm.id for lm in world.landmarks], dtype=np.int64)
         self.landmark_xyz = np.asarray([(lm.x, lm.y, lm.z) for lm in world.landmarks], dtype=float).reshape(-1, 3)
         self.landmark_size = np.asarray([lm.size for lm in world.landmarks], dtype=float)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from drivers.interfaces import RangeSource
-from drivers.sim.ranges import FIRING_PERIOD_S
+from drivers.sim.ranges import FIRING_PERIOD_S, WALL_THICKNESS, wall_ends_in_cones
 from tests.sim.conftest import drive_for
 
 WALL_AHEAD = """
@@ -49,6 +49,28 @@ def test_a_wall_straight_ahead_at_a_known_distance(sim_from):
     assert scan.ranges[3] == pytest.approx(expected, abs=1e-9) and scan.ranges[4] == pytest.approx(expected, abs=1e-9)
     assert np.all(np.isinf(scan.ranges[8:]))  # the rear ring hears nothing
     assert not scan.pressed.any()
+
+
+def test_a_wall_seen_end_on_is_heard_at_its_end(sim_from):
+    # a door jamb straight ahead: every ray of the front cones passes beside the line of the wall or
+    # meets it nowhere; a real wall is WALL_THICKNESS thick and its end is heard anywhere in the cone
+    sim = sim_from(WALL_AHEAD.replace("[[2, -20], [2, 20]]", "[[1.5, 0], [5, 0]]"))
+    settle(sim)
+    scan = sim.robot.ranges.read()
+    expected = math.hypot(1.5 - 0.166, 0.027) - WALL_THICKNESS / 2  # transducers 3 and 4 at (0.166, +-0.027)
+    assert scan.ranges[3] == pytest.approx(expected, abs=1e-9) and scan.ranges[4] == pytest.approx(expected, abs=1e-9)
+    assert np.isinf(scan.ranges[0]) and np.isinf(scan.ranges[7])  # the side transducers look past it
+
+
+@pytest.mark.parametrize(("heading_deg", "expected"), [
+    (0.0, 1.0 - 0.05),  # on the axis
+    (17.0, 1.0 - 0.05),  # off the axis by 17 deg: within 15 deg + asin(0.05 / 1) = 17.87 deg of it
+    (18.0, math.inf),  # outside the cone
+    (180.0, math.inf),  # behind the transducer
+])
+def test_a_wall_end_is_heard_where_any_of_its_face_is_in_the_cone(heading_deg, expected):
+    ranges = wall_ends_in_cones(np.zeros((1, 2)), np.radians([heading_deg]), np.radians([30.0]), np.array([[1.0, 0.0]]))
+    assert ranges[0] == pytest.approx(expected)
 
 
 def test_noise_scatters_the_range_around_the_true_one(sim_from):
