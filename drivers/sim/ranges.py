@@ -18,7 +18,8 @@ read, at the pose of the read (at most one tick late), with every firing since t
 done in its order; noise and misses draw from the run's own seeded stream, so the same seed gives
 the same readings.
 
-Not modelled: specular reflections at grazing angles, cross-talk, the cone's lobes.
+Not modelled: specular reflections at grazing angles, cross-talk, the cone's lobes, and a wall end
+hidden in the cone behind something its rays do not meet (the nearer thing is heard when they do).
 
 Bumpers: a segment is pressed while the robot's disc touches something (within
 :data:`CONTACT_M`: the simulator stops a robot at contact) and the point touched is nearer, in

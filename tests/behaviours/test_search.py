@@ -105,4 +105,3 @@ def test_search_fails_at_once_when_the_trail_was_lost_too_often_without_the_rout
     node.stop(Status.INVALID)
     harness.write("/map/route_progress", progress.retargeted(5, 1.0))  # the route moved on: counting starts again
     assert harness.tick() == Status.RUNNING and harness.read("/robot/command").v > 0.0
-
