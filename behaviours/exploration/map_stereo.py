@@ -29,7 +29,7 @@ from maps.exploration.grid import Cell, ExplorationMap, borders, mark_traversed
 from maps.exploration.head import StereoHead
 from maps.exploration.integrate import IntegrationParams, clear_rays, integrate_observation, observe
 from perception.frame import Frame
-from perception.geometry import Pose2D
+from perception.geometry import Pose2D, frame_to_parent
 from perception.ranges import RangeScan
 from perception.stereo import BELOW_FLOOR, pyramid_points
 
@@ -136,13 +136,10 @@ class MapStereo(BearingsBehaviour):
         if not echo.any():
             return
         sensors = [s for s, e in zip(scan.sensors, echo, strict=True) if e]
-        c, s_ = math.cos(pose.theta), math.sin(pose.theta)
         x, y, heading = (np.array([getattr(s, a) for s in sensors]) for a in ("x", "y", "heading"))
         reach = np.minimum(ranges[echo], self.ECHO_REACH + self._params.see_past)  # near the robot only
-        ends_x, ends_y = x + reach * np.cos(heading), y + reach * np.sin(heading)
-        to_odom = np.array([[c, -s_], [s_, c]])
-        origins = np.column_stack((x, y)) @ to_odom.T + (pose.x, pose.y)
-        ends = np.column_stack((ends_x, ends_y)) @ to_odom.T + (pose.x, pose.y)
+        origins = frame_to_parent(pose, np.column_stack((x, y)))  # base frame to odometry
+        ends = frame_to_parent(pose, np.column_stack((x + reach * np.cos(heading), y + reach * np.sin(heading))))
         self.map = clear_rays(self.map, origins, ends, self._params)
 
     def _integrate(self, pose: Pose2D) -> None:
