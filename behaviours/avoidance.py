@@ -49,6 +49,7 @@ import py_trees
 from py_trees.common import Status
 
 from behaviours.base import BearingsDecorator
+from behaviours.footprint import DEFAULT_FOOTPRINT, FOOTPRINT, footprint_of
 from behaviours.keys import RANGES_KEY, SAFETY_KEY
 from behaviours.motion import COMMAND, ODOMETRY
 from behaviours.ports import InputPort, OutputPort, Ref
@@ -102,8 +103,8 @@ class AvoidObstacles(BearingsDecorator):
                                 "false for a child whose own path turns (a search pattern)")
     MEMORY = InputPort("memory", float, 1.0, unit="s", minimum=0.0, maximum=10.0, literal_only=True,
                        doc="range echoes are remembered this long (odometry frame)")
-    ROBOT_RADIUS = InputPort("robot_radius", float, 0.26, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
-                             doc="radius of a disc that holds the robot's footprint")
+    ROBOT_RADIUS = InputPort("robot_radius", float, 0.0, unit="m", minimum=0.0, maximum=2.0, literal_only=True,
+                             doc="0: the robot's own footprint ('footprint'); a radius: a disc of it instead")
     CHILD_COMMAND = InputPort("child_command", VelocityCommand, Ref("/robot/command"), unit="m/s, rad/s",
                               doc="the command the child wrote this tick (its wish)")
     RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path), doc=RANGES_KEY.doc)
@@ -112,19 +113,12 @@ class AvoidObstacles(BearingsDecorator):
                       doc="true while it holds the robot for the way to clear by itself (the first 'wait' seconds)")
     RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
     PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, BACKOFF, PASS_TURNS,
-             GOING_ROUND, MEMORY, ROBOT_RADIUS, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
+             GOING_ROUND, MEMORY, ROBOT_RADIUS, FOOTPRINT, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
-        self.settings = AvoidSettings(
-            disc(self.get_input(self.ROBOT_RADIUS)), clearance=self.get_input(self.CLEARANCE),
-            horizon=self.get_input(self.HORIZON), speed=self.get_input(self.SPEED),
-            turn_rate=math.radians(self.get_input(self.TURN_RATE)), max_stray=self.get_input(self.MAX_STRAY))
-        self.avoidance = Avoidance(self.settings, DetourSettings(
-            wait=self.get_input(self.WAIT), timeout=self.get_input(self.TIMEOUT),
-            max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS),
-            going_round=self.get_input(self.GOING_ROUND)),
-            BackoffSettings(distance=self.get_input(self.BACKOFF)))
+        self.avoidance = self._avoidance(DEFAULT_FOOTPRINT)  # until the robot's own is known (first tick)
+        self._footprint_known = False
         self.memory = ObstacleMemory(self.get_input(self.MEMORY))
         self.decision: Decision | None = None
         self._events: list[str] = []
@@ -142,6 +136,9 @@ class AvoidObstacles(BearingsDecorator):
         pose = self.get_input(ODOMETRY, None)
         if wish is None or pose is None:  # the child commands nothing this tick: nothing to judge
             return Status.RUNNING
+        if not self._footprint_known:
+            self._footprint_known = True
+            self.avoidance = self._avoidance(footprint_of(self))
         now = self.now()
         scan = self.get_input(self.RANGES, None)
         if scan is not None:
@@ -161,6 +158,24 @@ class AvoidObstacles(BearingsDecorator):
             self.set_output(COMMAND, VelocityCommand(decision.v, decision.w))
         self.feedback_message = "" if decision.phase == "clear" else decision.event or self.feedback_message
         return Status.RUNNING
+
+    @property
+    def settings(self) -> AvoidSettings:
+        """The footprint and motions the avoidance judges with."""
+        return self.avoidance.avoid
+
+    def _avoidance(self, footprint: np.ndarray) -> Avoidance:
+        """The avoidance for the robot's ``footprint``, or for the disc of ``robot_radius`` when that is set."""
+        radius = self.get_input(self.ROBOT_RADIUS)
+        settings = AvoidSettings(
+            disc(radius) if radius > 0.0 else footprint, clearance=self.get_input(self.CLEARANCE),
+            horizon=self.get_input(self.HORIZON), speed=self.get_input(self.SPEED),
+            turn_rate=math.radians(self.get_input(self.TURN_RATE)), max_stray=self.get_input(self.MAX_STRAY))
+        return Avoidance(settings, DetourSettings(
+            wait=self.get_input(self.WAIT), timeout=self.get_input(self.TIMEOUT),
+            max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS),
+            going_round=self.get_input(self.GOING_ROUND)),
+            BackoffSettings(distance=self.get_input(self.BACKOFF)))
 
     def terminate(self, new_status: Status) -> None:
         if new_status != Status.RUNNING and self._clock is not None:

@@ -15,13 +15,18 @@ the mission's nodes declare:
   here (:data:`SENSED_KEYS`: the range sensors, which the collision monitor reads every tick);
 - the runner *writes* the collision monitor's verdict on the command it sent at the end of the
   previous tick (:data:`RUNNER_KEYS`: ``/robot/safety``, clear before the first), so a behaviour
-  can tell that the robot is being slowed or stopped, and why.
+  can tell that the robot is being slowed or stopped, and why;
+- the runner *writes* the robot's footprint before the first tick (``/robot/footprint``: the
+  collision monitor's, from the robot itself), so that nodes that plan round obstacles plan with
+  the robot's own outline rather than a number in a mission.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from drivers.interfaces import PanTiltCommand, VelocityCommand
 from perception.collision_monitor import SafetyState
@@ -46,7 +51,10 @@ COMMAND_KEYS = (
 
 SAFETY_KEY = KeySpec("/robot/safety", SafetyState, "the collision monitor on the last command sent: clear, slowed "
                      "or stopped, by which action and zone, and why")
-RUNNER_KEYS = (SAFETY_KEY,)
+FOOTPRINT_KEY = KeySpec("/robot/footprint", np.ndarray, "the robot's outline, a convex polygon [[x, y], ...] in the "
+                        "base frame (m): the collision monitor's (a Pioneer's model as it reports it, the "
+                        "simulator's disc, or the profile's safety.footprint)")
+RUNNER_KEYS = (SAFETY_KEY, FOOTPRINT_KEY)
 """Keys the runner writes every tick (besides the mission inputs)."""
 
 

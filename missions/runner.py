@@ -65,7 +65,7 @@ import py_trees
 from py_trees.common import Status
 
 from behaviours.clock import TickClock
-from behaviours.keys import COMMAND_KEYS, SAFETY_KEY, input_key
+from behaviours.keys import COMMAND_KEYS, FOOTPRINT_KEY, SAFETY_KEY, input_key
 from behaviours.telemetry import Draws, Event, Plot, Reports, Sections
 from drivers.interfaces import STOP, KeyboardOpener, PanTiltCommand, Robot, VelocityCommand
 from drivers.keyboard import TerminalKeys
@@ -174,7 +174,7 @@ class Runner:
         self.tree.add_pre_tick_handler(self._clear_commands)
         self.tree.add_post_tick_handler(self._dispatch)
         self.blackboard = py_trees.blackboard.Client(name="runner")
-        for spec in (*COMMAND_KEYS, SAFETY_KEY):
+        for spec in (*COMMAND_KEYS, SAFETY_KEY, FOOTPRINT_KEY):
             self.blackboard.register_key(key=spec.path, access=py_trees.common.Access.WRITE)
         overrun = self.options.overrun_s
         if overrun is None and self.clock.timeline == "wall_time":
@@ -220,6 +220,7 @@ class Runner:
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
         self.blackboard.set(SAFETY_KEY.path, self.guard.state)
+        self.blackboard.set(FOOTPRINT_KEY.path, self.guard.monitor.config.footprint)
         # hand every node the clock and the drivers (the keyboard as an opener: a terminal is taken only if used)
         self.tree.setup(clock=self.clock, robot=self.robot, keyboard=self.keyboard)
         self._drawers = [node for node in self.root.iterate() if isinstance(node, Reports | Draws)]

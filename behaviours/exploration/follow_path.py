@@ -68,7 +68,8 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.exploration.ports import CLEARANCE, GOAL, MAP, POSE, ROBOT_RADIUS
+from behaviours.exploration.ports import CLEARANCE, GOAL, MAP, POSE, ROBOT_RADIUS, disc_radius
+from behaviours.footprint import FOOTPRINT
 from behaviours.keys import RANGES_KEY
 from behaviours.motion import ANGULAR_DECEL, COMMAND, LINEAR_DECEL, STALLED, ramp
 from behaviours.ports import InputPort, OutputPort, Ref
@@ -206,8 +207,8 @@ class FollowPath(BearingsBehaviour):
         "unseen_ahead", Pose2D, "/robot/unseen_ahead",
         doc="the first point of the path ahead whose disc covers unseen floor (None: none)")
     PORTS = (SPEED, SPEED_LIMIT, TURN_RATE, TOLERANCE, LOOKAHEAD, TURN_IN_PLACE, CHECK_DISTANCE, CLEARANCE,
-             ROBOT_RADIUS, MARGIN, PENALTY, BACKOFF, MAX_STALLS, GUARD, STUCK_TIME, UNSEEN_MARGIN, CRAWL, FRONT,
-             APPROACH, REACTION, RANGES, GOAL, MAP, POSE, STALLED, COMMAND, UNSEEN_AHEAD)
+             ROBOT_RADIUS, FOOTPRINT, MARGIN, PENALTY, BACKOFF, MAX_STALLS, GUARD, STUCK_TIME, UNSEEN_MARGIN, CRAWL,
+             FRONT, APPROACH, REACTION, RANGES, GOAL, MAP, POSE, STALLED, COMMAND, UNSEEN_AHEAD)
     RANGES_OPTIONAL = True  # without range sensors nothing is in the lane: the map's checks alone
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
@@ -271,7 +272,7 @@ class FollowPath(BearingsBehaviour):
             return Status.RUNNING
         if self._blocked(m):
             self.replans += 1
-            planned = self.get_input(ROBOT_RADIUS) + self.get_input(CLEARANCE)
+            planned = disc_radius(self) + self.get_input(CLEARANCE)
             travel = travel_cost(m, (pose.x, pose.y), planned,
                                  margin=self.get_input(self.MARGIN), penalty=self.get_input(self.PENALTY))
             self.path, self.index = travel.path_to(goal.target), 0
@@ -303,7 +304,7 @@ class FollowPath(BearingsBehaviour):
                 self.get_input(self.SPEED_LIMIT, math.inf), blind)
         v = max(0.0, min(v, self._lane_speed()) * math.cos(error))
         self.blind_stops += int(blind < 0.02)
-        room = self.get_input(ROBOT_RADIUS) + self.get_input(CLEARANCE)
+        room = disc_radius(self) + self.get_input(CLEARANCE)
         reach = self.get_input(self.SPEED) ** 2 / (2.0 * LINEAR_DECEL) + 0.1
         free = free_travel(m, pose, w / max(v, 0.05), room, reach)
         v = min(v, math.sqrt(2.0 * LINEAR_DECEL * max(free - m.frame.resolution, 0.0)))  # stops in time
@@ -325,7 +326,7 @@ class FollowPath(BearingsBehaviour):
                 if math.isfinite(r) and abs(wrap_angle(s.heading)) <= s.fov / 2.0]
         if not gaps:
             return math.inf
-        gap = min(gaps) - self.get_input(ROBOT_RADIUS)
+        gap = min(gaps) - disc_radius(self)
         return approach_speed(gap, approach, LINEAR_DECEL, self.get_input(self.REACTION), self.get_input(CLEARANCE))
 
     def _nearest(self, here: np.ndarray) -> int:
@@ -348,7 +349,7 @@ class FollowPath(BearingsBehaviour):
             return False
         along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ahead, axis=0).T))))
         near = ahead[along <= self.get_input(self.CHECK_DISTANCE)]
-        return bool(np.any(disc_cells(m, near, self.get_input(ROBOT_RADIUS)) == Cell.OBSTACLE))
+        return bool(np.any(disc_cells(m, near, disc_radius(self)) == Cell.OBSTACLE))
 
     def _seen_distance(self, m: ExplorationMap, here: np.ndarray) -> float:
         """Distance to the first point of the path ahead (within ``guard``) where the front of the disc
@@ -357,7 +358,7 @@ class FollowPath(BearingsBehaviour):
         Unknown cells under the robot already (at the start, after a recovery) do not hold it, nor
         unknown floor beside the path: the cameras cannot see within ~0.5 m of the lens, so the floor
         beside a path along a border would never become seen from it."""
-        radius = self.get_input(ROBOT_RADIUS)
+        radius = disc_radius(self)
         ahead = self.path[self.index :]
         along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ahead, axis=0).T))))
         cos_front = math.cos(math.radians(self.get_input(self.FRONT)))

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -27,7 +28,8 @@ from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
 from behaviours.exploration.head import HEAD_PORTS, PTU_COMMAND, PTU_STATE, gaze_params, head_command, unit_params
-from behaviours.exploration.ports import MAP, POSE, ROBOT_RADIUS
+from behaviours.exploration.ports import MAP, POSE, ROBOT_RADIUS, disc_radius
+from behaviours.footprint import FOOTPRINT
 from behaviours.ports import InputPort, OutputPort
 from behaviours.registry import register
 from behaviours.telemetry import Arrows, Drawing, Figure, Points
@@ -85,7 +87,7 @@ class WatchInterestEdges(BearingsBehaviour):
                            doc="eq. 4's a: the far edge of the path this far ahead stays in the image")
     PORTS = (MODE, HOME_TILT, MAX_PAN, RATE_MARGIN, DWELL, TILT_STEP, MAX_SPEED, *HEAD_PORTS, TURN_RATE, NEAR_FLOOR,
              UNSEEN_AHEAD, MAP, POSE, PTU_COMMAND, SPEED_LIMIT, GAZE, LEAVE, TURN_BACK, KEEP_AHEAD, ROBOT_RADIUS,
-             PTU_STATE)
+             FOOTPRINT, PTU_STATE)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -94,7 +96,8 @@ class WatchInterestEdges(BearingsBehaviour):
                                  home_tilt=math.radians(self.get_input(self.HOME_TILT)),
                                  dwell=self.get_input(self.DWELL), leave=self.get_input(self.LEAVE),
                                  turn_back=self.get_input(self.TURN_BACK), keep_ahead=self.get_input(self.KEEP_AHEAD),
-                                 keep_across=self.get_input(ROBOT_RADIUS))
+                                 keep_across=self.get_input(ROBOT_RADIUS))  # 0: the footprint's (first tick)
+        self._sized = False
         self.params = self.asked
         self.gaze = Gaze()
         self.point: np.ndarray | None = None
@@ -117,6 +120,8 @@ class WatchInterestEdges(BearingsBehaviour):
 
     def update(self) -> Status:
         m, pose, unit = self.get_input(MAP, None), self.get_input(POSE, None), self.get_input(PTU_STATE, None)
+        if not self._sized:  # the robot's footprint is on the blackboard once the tree runs
+            self._sized, self.asked = True, replace(self.asked, keep_across=disc_radius(self))
         self.params = p = unit_params(self.asked, unit)
         top = self.get_input(self.MAX_SPEED)
         pan, tilt, limit, self.point = 0.0, p.home_tilt, top, None

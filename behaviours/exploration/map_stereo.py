@@ -18,7 +18,8 @@ from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
 from behaviours.exploration.drawing import map_drawings
-from behaviours.exploration.ports import CAMERA_POSITION, FRAMES, POSE, PTU_POSITION, ROBOT_RADIUS, xyz
+from behaviours.exploration.ports import CAMERA_POSITION, FRAMES, POSE, PTU_POSITION, ROBOT_RADIUS, disc_radius, xyz
+from behaviours.footprint import FOOTPRINT
 from behaviours.keys import RANGES_KEY
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
@@ -78,7 +79,7 @@ class MapStereo(BearingsBehaviour):
                        doc="range echoes: obstacle cells on a sensor's axis before its echo are cleared")
     MAP_OUT = OutputPort("map", ExplorationMap, "/map/exploration", doc="the exploration map (odometry frame)")
     PORTS = (CAMERA, PERIOD, NUM_DISPARITIES, STEP, LEVELS, MAX_JUMP, RESOLUTION, EXPLORE_RANGE, START_RADIUS,
-             ROBOT_RADIUS, PTU_POSITION, CAMERA_POSITION, FRAMES, PTU, POSE, RANGES, MAP_OUT)
+             ROBOT_RADIUS, FOOTPRINT, PTU_POSITION, CAMERA_POSITION, FRAMES, PTU, POSE, RANGES, MAP_OUT)
     RANGES_OPTIONAL = True  # without range sensors the cameras alone clear what they see past
     AREA_EVERY = 2.0  # s between samples of the explored area over time
     ECHO_REACH = 1.5  # m: echoes clear obstacle cells this near the sensor (where the cameras see least), no farther
@@ -113,7 +114,7 @@ class MapStereo(BearingsBehaviour):
             empty = ExplorationMap.empty(self.get_input(self.RESOLUTION), 5.0, (pose.x, pose.y))
             self.map = mark_traversed(empty, pose, self.get_input(self.START_RADIUS))
         else:
-            self.map = mark_traversed(self.map, pose, self.get_input(ROBOT_RADIUS))
+            self.map = mark_traversed(self.map, pose, disc_radius(self))
         self._clear_echoes(pose)
         self._integrate(pose)
         now = self.now()

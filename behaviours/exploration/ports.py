@@ -9,13 +9,14 @@ from __future__ import annotations
 
 from typing import Any
 
+from behaviours.footprint import robot_radius
 from behaviours.ports import InputPort, Ref
 from maps.exploration.goal import Goal
 from maps.exploration.grid import ExplorationMap
 from perception.geometry import Pose2D
 
-ROBOT_RADIUS = InputPort("robot_radius", float, 0.26, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
-                         doc="radius of the robot's disc")
+ROBOT_RADIUS = InputPort("robot_radius", float, 0.0, unit="m", minimum=0.0, maximum=2.0, literal_only=True,
+                         doc="radius of the robot's disc; 0: the disc round the robot's own footprint ('footprint')")
 CLEARANCE = InputPort("clearance", float, 0.05, unit="m", minimum=0.0, maximum=1.0, literal_only=True,
                       doc="room kept between the disc and obstacle cells beyond robot_radius (localisation "
                           "error): paths are planned with it, and FollowPath stops the robot short of it")
@@ -29,6 +30,12 @@ CAMERA_POSITION = InputPort("camera_position", list[float], [0.05, 0.0, 0.08], u
                             doc="the left stereo camera on the pan-tilt head: x, y, z")
 FRAMES: InputPort[dict[str, Any]] = InputPort("frames", dict, Ref("/perception/frames"),
                                               doc="the latest frame of each camera, by name")
+
+
+def disc_radius(node: object) -> float:
+    """The radius of the robot's disc for ``node``: its ``robot_radius``, or (0) the disc round the
+    robot's own footprint (:mod:`behaviours.footprint`)."""
+    return robot_radius(node, node.get_input(ROBOT_RADIUS))  # type: ignore[attr-defined]
 
 
 def xyz(values: list[float], what: str) -> tuple[float, float, float]:

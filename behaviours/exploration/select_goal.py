@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.exploration.ports import CLEARANCE, MAP, POSE, ROBOT_RADIUS
+from behaviours.exploration.ports import CLEARANCE, MAP, POSE, ROBOT_RADIUS, disc_radius
+from behaviours.footprint import FOOTPRINT
 from behaviours.ports import InputPort, OutputPort
 from behaviours.registry import register
 from behaviours.telemetry import Drawing, Figure, Lines, Points
@@ -109,7 +111,8 @@ class SelectGoalPoint(BearingsBehaviour):
     GOAL_OUT: OutputPort[Goal | None] = OutputPort("goal", Goal, "/map/exploration_goal",
                                                    doc="the goal: border point, path, mode (None: none)")
     PORTS = (STRATEGY, ETA, K, ROBOT_RADIUS, CLEARANCE, MARGIN, PENALTY, PATIENCE, MIN_FRONTIER, HYSTERESIS,
-             RESELECT, REACH, MIN_SIGHTINGS, POINT_CLEARANCE, VERIFY_RADIUS, LOOK_BACK, MAP, POSE, GOAL_OUT, NEARBY)
+             RESELECT, REACH, MIN_SIGHTINGS, POINT_CLEARANCE, VERIFY_RADIUS, LOOK_BACK, MAP, POSE, GOAL_OUT, NEARBY,
+             FOOTPRINT)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -126,6 +129,7 @@ class SelectGoalPoint(BearingsBehaviour):
             point_clearance=self.get_input(self.POINT_CLEARANCE),
             verify_radius=self.get_input(self.VERIFY_RADIUS), look_back=self.get_input(self.LOOK_BACK),
         )  # fmt: skip
+        self._sized = False  # robot_radius 0: the footprint's, known once the tree runs
         self.switch = ModeSwitch()
         self.goal: Goal | None = None
         self.avoid: list[tuple[float, float]] = []  # reached or abandoned: avoided until a second chance
@@ -144,12 +148,19 @@ class SelectGoalPoint(BearingsBehaviour):
     def initialise(self) -> None:
         self.goal = None  # choose afresh on every entry
 
+    def _size(self) -> None:
+        """Plan for the robot's own disc (robot_radius 0), known once the tree runs: on the first tick."""
+        if not self._sized:
+            self._sized = True
+            self.params = replace(self.params, robot_radius=disc_radius(self) + self.get_input(CLEARANCE))
+
     def update(self) -> Status:
         m = self.get_input(MAP, None)
         pose = self.get_input(POSE, None)
         if m is None or pose is None:
             self.feedback_message = "waiting for the map and a pose"
             return Status.RUNNING
+        self._size()
         goal, now = self.goal, self.now()
         reached = goal is not None and math.hypot(pose.x - goal.target[0], pose.y - goal.target[1]) <= self.get_input(
             self.REACH)

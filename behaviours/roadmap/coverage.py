@@ -32,12 +32,13 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
+from behaviours.footprint import FOOTPRINT
 from behaviours.motion import ODOMETRY
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import Drawn, coverage_drawings, roadmap_figures
 from behaviours.roadmap.room import ROOM_IN
-from behaviours.roadmap.routine import ROBOT_RADIUS
+from behaviours.roadmap.routine import ROBOT_RADIUS, robot_disc
 from behaviours.roadmap.values import ScanRecord
 from behaviours.telemetry import Drawing, Figure
 from maps.coverage import FRAGMENT_COST as DEFAULT_FRAGMENT_COST
@@ -62,7 +63,7 @@ class CoverageScoring(BearingsBehaviour):
                               doc="configurations one more uncovered fragment is worth")
     COVERAGE = OutputPort("coverage", CoverageGrid, "/map/coverage", doc="the coverage grid")
     GOAL = OutputPort("goal", Pose2D, "/map/coverage_goal", doc="the next search position (reference frame)")
-    PORTS = (ROOM_IN, SCAN, ROBOT_RADIUS, MIN_NEW, FRAGMENT_COST, ODOMETRY, COVERAGE, GOAL)
+    PORTS = (ROOM_IN, SCAN, ROBOT_RADIUS, FOOTPRINT, MIN_NEW, FRAGMENT_COST, ODOMETRY, COVERAGE, GOAL)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
@@ -79,7 +80,7 @@ class CoverageScoring(BearingsBehaviour):
         if room is None or odometry is None:
             self.feedback_message = "no room estimate" if room is None else "waiting for odometry"
             return Status.FAILURE if room is None else Status.RUNNING
-        radius = self.get_input(ROBOT_RADIUS)
+        radius = robot_disc(self)
         grid = self.grid or coverage_grid(room, room.free, robot_radius=radius)
         scan = self.get_input(self.SCAN, None)
         if scan is not None and scan.seq not in self.applied:

@@ -70,7 +70,7 @@ from behaviours.roadmap.display import Drawn, roadmap_drawings, roadmap_figures,
 from behaviours.roadmap.homing import REQUIRED_ROOM, HomingSettings, home
 from behaviours.roadmap.paths import PLAN_PORTS, reanchored, travel
 from behaviours.roadmap.room import ROOM_IN
-from behaviours.roadmap.routine import ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step, robot_disc
 from behaviours.roadmap.targets import TARGETS_IN, relative_images
 from behaviours.roadmap.travel import REFERENCE_IN, return_to_reference
 from behaviours.roadmap.values import TargetImages, TargetView
@@ -178,7 +178,7 @@ class BuildGraph(RoutineBehaviour):
     def _pairs(self, roadmap: Roadmap) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
         """Pairs not measured yet: those whose straight segment the room estimate knows as free, the others."""
         assert self.room is not None
-        radius = self.get_input(ROBOT_RADIUS)
+        radius = robot_disc(self)
         free, unknown = [], []
         for a, b in combinations(sorted(roadmap.names), 2):
             if roadmap.motion(a, b) is not None:

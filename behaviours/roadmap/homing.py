@@ -58,7 +58,15 @@ from behaviours.registry import register
 from behaviours.roadmap.paths import travel
 from behaviours.roadmap.room import ROOM_IN
 from behaviours.roadmap.room_to_move import straight_reach
-from behaviours.roadmap.routine import RANGES_IN, ROBOT_RADIUS, ROUTINE_PORTS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.routine import (
+    RANGES_IN,
+    ROBOT_RADIUS,
+    ROUTINE_PORTS,
+    Failed,
+    RoutineBehaviour,
+    Step,
+    robot_disc,
+)
 from behaviours.roadmap.scan import MIN_INLIERS_IN
 from behaviours.roadmap.targets import TARGETS_IN
 from behaviours.roadmap.values import HomingResult, TargetView
@@ -212,7 +220,7 @@ def _free_side(host: RoutineBehaviour, first: Look, settings: HomingSettings, si
         end = Pose2D(first.odometry.x + sign * settings.step * math.cos(heading),
                      first.odometry.y + sign * settings.step * math.sin(heading))
         there = room.to_reference(end)
-        free.append(bool(room.free.can_stand(np.array([[there.x, there.y]]), host.get_input(ROBOT_RADIUS))[0]))
+        free.append(bool(room.free.can_stand(np.array([[there.x, there.y]]), robot_disc(host))[0]))
     return -side if (free[1] and not free[0]) else side
 
 
@@ -223,7 +231,7 @@ def _step_plan(host: RoutineBehaviour, first: Look, settings: HomingSettings, si
     points = host.sensed()
     if points is None:
         return side, settings.step
-    radius = host.get_input(ROBOT_RADIUS)
+    radius = robot_disc(host)
     room: dict[int, float] = {}
     for candidate in (side, -side):
         turn, sign = _step_motion(first, candidate)

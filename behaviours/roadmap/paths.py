@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from behaviours.ports import InputPort, OutputPort, Port
-from behaviours.roadmap.routine import ROBOT_RADIUS, Failed, RoutineBehaviour, Step
+from behaviours.roadmap.routine import Failed, RoutineBehaviour, Step, robot_disc
 from maps.planning import PlanResult, plan_path
 from maps.room import FreeGrid, RoomEstimate
 from perception.geometry import Pose2D
@@ -66,7 +66,7 @@ def plan(host: RoutineBehaviour, room: RoomEstimate, goal: Pose2D) -> Step[PlanR
 
     Written to the host's ``plan`` output when it has one; :class:`Failed` when there is none.
     """
-    radius = host.get_input(ROBOT_RADIUS)
+    radius = robot_disc(host)
     here = room.to_reference((yield from host.pose()))
     start = nearest_standable(room.free, here.x, here.y, radius, snap=math.inf)  # the robot is on free floor
     end = nearest_standable(room.free, goal.x, goal.y, radius)

@@ -26,6 +26,7 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
+from behaviours.footprint import FOOTPRINT, robot_radius
 from behaviours.keys import RANGES_KEY
 from behaviours.motion import COMMAND, ODOMETRY, STALLED, Drive, DriveTo, Rotate
 from behaviours.ports import InputPort, OutputPort, Port, Ref
@@ -64,14 +65,23 @@ SPEED = InputPort("speed", float, 0.3, unit="m/s", minimum=0.01, maximum=1.2, do
 TURN_SPEED = InputPort("turn_speed", float, 45.0, unit="deg/s", minimum=1.0, maximum=300.0, doc="top turn rate")
 SETTLE = InputPort("settle", float, 0.3, unit="s", minimum=0.0, maximum=5.0,
                    doc="time at rest before an image is taken")
-ROBOT_RADIUS = InputPort("robot_radius", float, 0.28, unit="m", minimum=0.05, maximum=2.0, literal_only=True,
-                         doc="radius of the disc the robot occupies (with a margin)")
+ROBOT_RADIUS = InputPort("robot_radius", float, 0.0, unit="m", minimum=0.0, maximum=2.0, literal_only=True,
+                         doc="radius of the disc the robot occupies (with a margin); 0: the disc round the robot's "
+                             "own footprint ('footprint') grown by 0.02 m")
+DISC_MARGIN = 0.02  # m: robot_radius 0 is the footprint's disc grown by this (a P3-DX's 0.26 m: 0.28 m)
 RANGES_IN = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path),
                       doc="range sensors around the base: a homing judges its sidesteps by them (absent: not judged)")
 RANGES_MEMORY = 1.0  # s of echoes judged together (a sonar ring fires one transducer at a time)
 ROUTINE_PORTS: tuple[Port, ...] = (CAMERA, CAMERA_OFFSET, SPEED, TURN_SPEED, SETTLE, ODOMETRY, STALLED, FRAMES, HEAD,
-                                   COMMAND, HEAD_COMMAND)
-"""Ports every routine has: its camera, motion limits, the robot's state and its two commands."""
+                                   FOOTPRINT, COMMAND, HEAD_COMMAND)
+"""Ports every routine has: its camera, motion limits, the robot's state and footprint, its two commands."""
+
+
+def robot_disc(host: BearingsBehaviour) -> float:
+    """The radius of the disc ``host`` plans the robot as: its ``robot_radius``, or (0) the disc round
+    the robot's own footprint (:mod:`behaviours.footprint`) grown by :data:`DISC_MARGIN`."""
+    given = host.get_input(ROBOT_RADIUS)
+    return given if given > 0.0 else robot_radius(host, 0.0) + DISC_MARGIN
 
 
 class RoutineBehaviour(BearingsBehaviour):

@@ -22,6 +22,7 @@ from drivers.interfaces import VelocityCommand
 from drivers.pioneer_body import BODIES
 from perception.collision_monitor import SafetyState
 from perception.geometry import Pose2D
+from perception.polygons import disc
 from perception.ranges import RangeScan
 
 RING = BODIES["p3dx"].sensors()
@@ -58,6 +59,22 @@ def test_a_clear_way_passes_the_childs_command_unchanged():
     assert h.tick() == Status.RUNNING
     assert command(h) == (0.3, 0.0)  # Drive's own, at its top speed
     assert report_sections(h.behaviour)["avoidance"]["avoid"]["waits"] == 0
+
+
+def test_the_way_is_judged_for_the_robots_own_footprint_unless_a_radius_is_given():
+    # Something 1 m ahead: transducers 3 and 4 read 0.85 m, echoes at (1.003, +-0.175). The 0.26 m disc
+    # grown by 0.1 m meets them after 1.003 - sqrt(0.36^2 - 0.175^2) = 0.688 m, past the 0.33 m a 0.3 m/s
+    # Drive needs; a robot of 0.65 m (grown: 0.75 m) after 1.003 - sqrt(0.75^2 - 0.175^2) = 0.274 m: blocked.
+    ahead = {3: 0.85, 4: 0.85}
+    small = harness(ahead)  # no footprint published (no runner): a P3-DX's 0.26 m disc
+    assert small.tick() == Status.RUNNING and command(small) == (0.3, 0.0)
+    big = harness(ahead)
+    big.write("/robot/footprint", disc(0.65))  # what the runner publishes: the collision monitor's footprint
+    assert big.tick() == Status.RUNNING and command(big) == (0.0, 0.0)
+    assert big.behaviour.feedback_message.startswith("the way is blocked")
+    told = harness(ahead, robot_radius=0.26)  # a radius given in the mission wins
+    told.write("/robot/footprint", disc(0.65))
+    assert told.tick() == Status.RUNNING and command(told) == (0.3, 0.0)
 
 
 def test_a_person_walking_across_is_waited_for_and_the_child_drives_on():

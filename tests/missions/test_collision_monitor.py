@@ -163,3 +163,19 @@ def test_bearings_run_ends_with_the_collisions_the_stops_and_the_clearance(capsy
     assert summary_line(report) == (
         "ground truth: collisions 0, min clearance 0.079 m, trajectory length 1.200 m; safety: safety stops 2, "
         "slowdowns 1, bumper hits 0, min range 0.081 m, sources scene sonar (16 transducers)")
+
+
+def test_the_runner_publishes_the_robots_own_footprint_before_the_first_tick(write_mission):
+    mission = load_mission(write_mission("""
+        cameras: []
+        tree: {Drive: {distance: 0.1}}
+        """))
+    clock = ManualClock()
+    seen: list[np.ndarray] = []
+    runner = Runner(mission, Robot(base=FakeBase()), clock=clock, options=RunOptions(max_time_s=0.3),
+                    safety=monitor_config(None, BODIES["p3at"].footprint),
+                    on_tick=lambda r: seen.append(r.blackboard.get("/robot/footprint")))
+    runner.run()
+    # ARIA's p3at.p: RobotLengthFront/Rear 313 mm, RobotWidth 505 mm
+    assert seen and np.array_equal(seen[0], BODIES["p3at"].footprint)
+    assert np.abs(seen[0]).max(axis=0) == pytest.approx((0.313, 0.2525))

@@ -56,10 +56,10 @@ def test_reading_a_key_nobody_writes_is_refused_with_its_line(write_mission):
     assert problems(path) == [
         (5, "Drive.distance reads /mission/distance_nobody_writes, which nothing writes (written keys: "
             "/mission/distance, /perception/frame, /perception/frames, /ptu/state, /robot/command, "
-            "/robot/odometry, /robot/ranges, /robot/safety, /robot/stalled)"),
+            "/robot/footprint, /robot/odometry, /robot/ranges, /robot/safety, /robot/stalled)"),
         (6, "CheckBlackboard.key reads /mission/never_written, which nothing writes (written keys: "
             "/mission/distance, /perception/frame, /perception/frames, /ptu/state, /robot/command, "
-            "/robot/odometry, /robot/ranges, /robot/safety, /robot/stalled)"),
+            "/robot/footprint, /robot/odometry, /robot/ranges, /robot/safety, /robot/stalled)"),
         (7, "Drive.distance reads /mission/distanse, which nothing writes; did you mean '/mission/distance'?"),
     ]
 

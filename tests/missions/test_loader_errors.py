@@ -78,8 +78,8 @@ def test_bad_blackboard_reference(write_mission):
     found = problems(path)
     assert found == [
         (4, "Drive.distance reads /map/nowhere, which nothing writes (written keys: /perception/frame, "
-            "/perception/frames, /ptu/state, /robot/command, /robot/odometry, /robot/ranges, /robot/safety, "
-            "/robot/stalled)"),
+            "/perception/frames, /ptu/state, /robot/command, /robot/footprint, /robot/odometry, /robot/ranges, "
+            "/robot/safety, /robot/stalled)"),
         (5, "Wait.duration is float, but /robot/odometry holds Pose2D (written by the data-gathering branch)"),
     ]
     outside = write_mission('tree: {Drive: {distance: "{/elsewhere/x}"}}\n', name="outside.yaml")
