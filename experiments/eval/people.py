@@ -8,7 +8,10 @@ even odds:
 - **standing** on the way the robot is to go, leaving it a way past (:meth:`_Placer.leaves_a_way`:
   the robot's disc grown by the avoidance's clearance gets from the way 1.5 m before them to the
   way 1.5 m after them, clear of every surface and every other person standing; a person in the
-  middle of a hallway too narrow for that would test only that the robot stops), or
+  middle of a hallway too narrow for that would test only that the robot stops); in the rooms
+  (``exploration``), standing where they cut none of the floor off (:meth:`_Placer.keeps_floor`: a
+  person standing in the only door to two rooms makes them unreachable, and the coverage asked
+  for impossible), or
 - **crossing** it: walking back and forth across it, square to it, up to :data:`CROSSING` m to
   each side (cut where a wall, box or pillar comes nearer than the person's radius), at a speed
   in :data:`SPEEDS`, waiting up to :data:`WAIT_S` s at each end.
@@ -89,6 +92,7 @@ class _Placer:
         self.placed: list[Walker] = []
         self.passer = world.robot_radius + PASSING  # the robot's disc grown by the clearance it keeps
         self.standing: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []  # on a way: (where, before, after)
+        self._reached: np.ndarray | None = None  # keeps_floor: the floor reached with nobody standing
 
     def leaves_a_way(self, p: np.ndarray, before: np.ndarray, after: np.ndarray, extra: Walker | None = None
                      ) -> bool:
@@ -114,6 +118,27 @@ class _Placer:
             found = np.unique(near[near > 0])
             ends.append(set(found.tolist()))
         return bool(ends[0] & ends[1])
+
+    def keeps_floor(self, grid: FloorGrid, p: np.ndarray) -> bool:
+        """Whether a person standing at ``p``, with everybody standing already, leaves the robot's
+        disc, grown by the clearance it keeps, all the floor of ``grid`` it reached without them, but
+        for the floor round them: nobody standing cuts a room off."""
+        rows, cols = np.indices(grid.free.shape)
+        centres = np.stack(((cols + 0.5) * grid.resolution + grid.x0, (rows + 0.5) * grid.resolution + grid.y0), -1)
+        standing = [np.asarray(w.path[0]) for w in self.placed if len(w.path) == 1]
+        near = np.min([np.hypot(*(centres - q).transpose(2, 0, 1)) for q in (*standing, p)], axis=0)
+        if self._reached is None:
+            self._reached = self._reach(grid, ~grid.free)
+        lost = self._reached & ~self._reach(grid, ~grid.free | (near <= RADIUS))
+        return not np.any(lost & (near > RADIUS + self.passer + 2 * grid.resolution))
+
+    def _reach(self, grid: FloorGrid, occupied: np.ndarray) -> np.ndarray:
+        """Where the grown disc's centre goes from the world's start, ``occupied`` in the way."""
+        room = ndimage.distance_transform_edt(~occupied, sampling=grid.resolution) > self.passer
+        labels, _ = ndimage.label(room)
+        rows, cols, _ = grid.cells_of(np.array([[self.world.start.x, self.world.start.y]]))
+        start = labels[rows[0], cols[0]]
+        return labels == start if start else np.zeros_like(room)
 
     def keeps_ways(self, walker: Walker) -> bool:
         """Whether everybody standing on a way still leaves the robot a way past with ``walker`` placed."""
@@ -217,7 +242,8 @@ def in_rooms(world: World, grid: FloorGrid, count: int, seed: int, *,
             if not grid.reachable_at(p[None, :])[0]:
                 continue
             if rng.uniform() < 0.5:
-                walker = Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) else None
+                walker = Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) and placer.keeps_floor(grid, p) \
+                    else None
             else:
                 heading = rng.uniform(-math.pi, math.pi)
                 q = p + rng.uniform(*WALK) * np.array([math.cos(heading), math.sin(heading)])

@@ -104,6 +104,31 @@ def test_people_in_rooms_are_on_the_floor_the_robot_reaches(world_file):
     assert np.all(np.hypot(*(points - [world.start.x, world.start.y]).T) >= KEEP_CLEAR_M)
 
 
+TWO_ROOMS = """
+name: two_rooms
+start: {x: 1.0, y: 2.0, theta_deg: 0}
+walls:
+  - {points: [[0, 0], [10, 0], [10, 4], [0, 4]], closed: true, height: 2.5}
+  - {points: [[5, 0], [5, 1.5]], height: 2.5}
+  - {points: [[5, 2.5], [5, 4]], height: 2.5}
+"""
+
+
+def test_nobody_stands_where_they_cut_a_room_off(world_file):
+    # the door is 1 m wide (y 1.5-2.5): a person (0.25 m) in it leaves 0.375 m on each side, and the
+    # robot's disc grown by the clearance it keeps needs 0.72 m: the east room would be cut off
+    world = load_world(world_file(TWO_ROOMS))
+    floor = reachable_floor(world)
+    placer = _Placer(world, keep_clear=[])
+    assert not placer.keeps_floor(floor, np.array([5.0, 2.0]))  # in the door
+    assert not placer.keeps_floor(floor, np.array([5.4, 2.0]))  # just inside the east room, in front of it
+    assert placer.keeps_floor(floor, np.array([7.5, 2.0]))  # in the middle of the east room
+    assert placer.keeps_floor(floor, np.array([2.5, 3.0]))  # beside the west room's wall: a way round
+    people = [w for seed in range(10) for w in in_rooms(world, floor, 4, seed=seed, keep_clear=[(1.0, 2.0)])]
+    standing = np.array([w.path[0] for w in people if len(w.path) == 1])
+    assert len(standing) and not np.any(np.hypot(*(standing - [5.0, 2.0]).T) < 0.9)  # none near the door
+
+
 def test_a_world_with_no_room_gets_fewer_people(world_file):
     world = load_world(world_file(HALL))
     assert on_ways(world, [np.array([[1.0, 2.0], [2.5, 2.0]])], 3, seed=0, keep_clear=[[1.0, 2.0], [2.5, 2.0]]) == []
