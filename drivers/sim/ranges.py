@@ -37,7 +37,7 @@ import numpy as np
 from drivers.pioneer_body import BODIES, RING_SIZE
 from drivers.sim.scene import Scene
 from drivers.sim.world_values import RangeSpec
-from perception.geometry import Pose2D, wrap_angle
+from perception.geometry import Pose2D, frame_to_parent, wrap_angle, wrap_angles
 from perception.ranges import Bumper, RangeScan, RangeSensor
 
 FIRING_PERIOD_S = 0.04  # s: one transducer per ring every 40 ms (25 Hz, the Pioneer 3's rate)
@@ -55,7 +55,7 @@ def wall_ends_in_cones(origins: np.ndarray, headings: np.ndarray, fov: np.ndarra
     radius = WALL_THICKNESS / 2.0
     offset = ends[None, :, :] - origins[:, None, :]  # (N, E, 2)
     distance = np.hypot(offset[..., 0], offset[..., 1])
-    off_axis = np.abs(np.angle(np.exp(1j * (np.arctan2(offset[..., 1], offset[..., 0]) - headings[:, None]))))
+    off_axis = np.abs(wrap_angles(np.arctan2(offset[..., 1], offset[..., 0]) - headings[:, None]))
     half = np.arcsin(np.clip(radius / np.maximum(distance, radius), 0.0, 1.0))  # half the disc's width seen
     inside = off_axis <= fov[:, None] / 2.0 + half
     return np.where(inside, np.maximum(distance - radius, 0.0), np.inf).min(axis=1)
@@ -99,10 +99,7 @@ class SimRanges:
 
     def _fire(self, which: np.ndarray, pose: Pose2D) -> None:
         """Range of each transducer in ``which`` (in that order) from ``pose``, with noise and misses."""
-        c, s = math.cos(pose.theta), math.sin(pose.theta)
-        x = np.array([self.sensors[i].x for i in which])
-        y = np.array([self.sensors[i].y for i in which])
-        origins = np.column_stack([pose.x + c * x - s * y, pose.y + s * x + c * y])
+        origins = frame_to_parent(pose, np.array([(self.sensors[i].x, self.sensors[i].y) for i in which]))
         angles = self._ray_angles[which] + pose.theta  # (n, rays)
         dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1).reshape(-1, 2)
         true = self.scene.cast_rays(np.repeat(origins, RAYS_PER_CONE, axis=0), dirs)
