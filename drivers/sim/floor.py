@@ -106,6 +106,16 @@ def rasterise(world: World, x0: float, y0: float, resolution: float, shape: tupl
     return occupied.astype(bool)
 
 
+def reached_from(occupied: np.ndarray, resolution: float, radius: float, cell: tuple[int, int]) -> np.ndarray:
+    """The cells where the centre of a disc of ``radius`` goes from ``cell`` (row, col), keeping the
+    disc off ``occupied`` (bool grid of ``resolution`` m); all False when the disc does not fit at ``cell``."""
+    clearance = ndimage.distance_transform_edt(~occupied, sampling=resolution) if occupied.any() else None
+    centre_ok = ~occupied if clearance is None else clearance > radius
+    labels, _ = ndimage.label(centre_ok)
+    start = labels[cell]
+    return labels == start if start else np.zeros_like(centre_ok)
+
+
 def reachable_floor(world: World, resolution: float = 0.05, radius: float | None = None,
                     window: tuple[float, float, float, float] | None = None) -> FloorGrid:
     """The reachable free floor of ``world`` (see the module docstring); ``radius``: the world's robot.
@@ -125,15 +135,12 @@ def reachable_floor(world: World, resolution: float = 0.05, radius: float | None
     x0, y0 = xmin - margin, ymin - margin
     shape = (int(math.ceil((ymax + margin - y0) / resolution)), int(math.ceil((xmax + margin - x0) / resolution)))
     occupied = rasterise(world, x0, y0, resolution, shape)
-    clearance = ndimage.distance_transform_edt(~occupied, sampling=resolution) if occupied.any() else None
-    centre_ok = ~occupied if clearance is None else clearance > radius
-    labels, _ = ndimage.label(centre_ok)
     row = int(math.floor((world.start.y - y0) / resolution))
     col = int(math.floor((world.start.x - x0) / resolution))
-    if labels[row, col] == 0:
+    reachable = reached_from(occupied, resolution, radius, (row, col))
+    if not reachable.any():
         where = f"({world.start.x:g}, {world.start.y:g})"
         raise ValueError(f"the start pose {where} is not free for a robot of radius {radius:g} m")
-    reachable = labels == labels[row, col]
     bounded = not (reachable[0].any() or reachable[-1].any() or reachable[:, 0].any() or reachable[:, -1].any())
     swept = ndimage.distance_transform_edt(~reachable, sampling=resolution) <= radius
     return FloorGrid(x0, y0, resolution, ~occupied, reachable, swept & ~occupied, bounded)

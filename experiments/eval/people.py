@@ -37,7 +37,7 @@ import yaml
 from scipy import ndimage
 
 from behaviours.avoidance import AvoidObstacles
-from drivers.sim.floor import FloorGrid, rasterise
+from drivers.sim.floor import FloorGrid, rasterise, reached_from
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, shipped_worlds
 from experiments.eval import count_option
@@ -134,11 +134,8 @@ class _Placer:
 
     def _reach(self, grid: FloorGrid, occupied: np.ndarray) -> np.ndarray:
         """Where the grown disc's centre goes from the world's start, ``occupied`` in the way."""
-        room = ndimage.distance_transform_edt(~occupied, sampling=grid.resolution) > self.passer
-        labels, _ = ndimage.label(room)
         rows, cols, _ = grid.cells_of(np.array([[self.world.start.x, self.world.start.y]]))
-        start = labels[rows[0], cols[0]]
-        return labels == start if start else np.zeros_like(room)
+        return reached_from(occupied, grid.resolution, self.passer, (int(rows[0]), int(cols[0])))
 
     def keeps_ways(self, walker: Walker) -> bool:
         """Whether everybody standing on a way still leaves the robot a way past with ``walker`` placed."""
