@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from behaviours.footprint import robot_radius
 from behaviours.motion import ODOMETRY
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
@@ -103,6 +104,15 @@ class RoomEstimationDodecagon(RoutineBehaviour):
     def mount(self) -> RigMount:
         return RigMount(self.get_input(self.RIG_HEIGHT), self.pan_axis, self.rig_offset)
 
+    def room_needed(self) -> str:
+        """What the dodecagon needs round the start, for a failure to say (a user starts the robot)."""
+        side = self.get_input(self.SIDE)
+        circle = side / (2.0 * math.sin(math.pi / CORNERS))  # the corners' circle (maps.room.dodecagon)
+        disc = robot_radius(self, 0.0)
+        return (f"the dodecagon (side {side:.2f} m) needs a free disc {2.0 * (circle + disc):.2f} m across, its "
+                f"centre {circle:.2f} m to the robot's left at the start (corners on a {circle:.2f} m circle, the "
+                f"robot's disc {disc:.2f} m): start the robot in open floor, or give a smaller side")
+
     def routine(self) -> Step[None]:
         stereo, camera = self.get_input(self.STEREO_CAMERA), self.get_input(CAMERA)
         views: list[StereoView] = []
@@ -110,8 +120,11 @@ class RoomEstimationDodecagon(RoutineBehaviour):
         self._points, self._features = [], []
         for corner in range(CORNERS):
             if corner:  # paper: take the pair, turn 30 degrees, drive to the next corner
-                yield from self.rotate(2.0 * math.pi / CORNERS, f"turning at corner {corner}")
-                yield from self.drive(self.get_input(self.SIDE), f"driving to corner {corner + 1}")
+                try:
+                    yield from self.rotate(2.0 * math.pi / CORNERS, f"turning at corner {corner}")
+                    yield from self.drive(self.get_input(self.SIDE), f"driving to corner {corner + 1}")
+                except Failed as exc:
+                    raise Failed(f"{exc}; {self.room_needed()}") from None
             frames, pose = yield from self.capture_all((stereo, camera))
             points = stereo_points(frames[stereo], self.get_input(self.STEREO))
             features = describe(frames[camera].image)

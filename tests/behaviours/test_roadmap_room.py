@@ -112,3 +112,15 @@ def test_the_rig_is_mounted_as_its_ports_say():
     assert node.mount() == RigMount(1.2, (0.2, 0.01), (0.04, -0.06))
     with pytest.raises(ValueError, match=r"RoomEstimationDodecagon.pan_axis takes \[x, y\], got \[0.1\]"):
         RoomEstimationDodecagon(pan_axis=[0.1])
+
+
+def test_a_dodecagon_that_does_not_fit_says_what_room_it_needs():
+    """Started 0.5 m from the lab's west wall facing north: the corners' circle (centre to the left,
+    radius 0.25 / (2 sin 15 deg) = 0.483 m) runs into the wall; the robot stalls against it."""
+    world = FakeWorld(start=Pose2D(0.5, 1.5, math.radians(90)), cameras=("stereo", "front"))
+    node = RoomEstimationDodecagon()
+    harness = BehaviourHarness(node, blackboard=world.blackboard())
+    assert harness.tick_until(between=world.step, max_ticks=3000) == Status.FAILURE
+    # 2 (0.483 + 0.26) = 1.486 m: the corners' circle and the default robot disc (nothing published)
+    assert "driving to corner" in node.feedback_message
+    assert "needs a free disc 1.49 m across, its centre 0.48 m to the robot's left" in node.feedback_message
