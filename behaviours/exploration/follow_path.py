@@ -46,6 +46,13 @@ disparities) and may be looking sideways:
   braking distance and 0.5 s of travel, 0.57 m) found the way free until 0.4 s before the contact,
   and the base, braking, touched the person who had stopped for it. A person 1 m ahead walking
   towards the robot at 1 m/s leaves it 0.2 m/s; 2 m ahead, full speed.
+- **Something stepping onto the path**: when the path ahead is blocked and no path round reaches
+  the goal, but the obstacle cells that block it were free floor on the last map on which the way
+  was clear (something moved there: a person walking past or standing in a door), the robot stops
+  and waits up to ``wait`` seconds for them to clear (the map clears a cell once the floor past it
+  is seen) before it gives the goal up. What was unknown before (a wall just seen) gives it up at
+  once. Before, a person crossing a door the robot was about to pass made it give every goal
+  beyond the door up, one after another, and end "done" with the rooms behind unvisited.
 - **Progress**: no metre of path gained for ``stuck_time`` seconds (a stop before unseen floor the
   cameras cannot see from here: nearer than their ~0.5 m blind zone): FAILURE, so that a recovery
   looks around and the goal is chosen again.
@@ -118,6 +125,16 @@ def disc_cells(m: ExplorationMap, centres: np.ndarray, radius: float) -> np.ndar
     blocked by this)."""
     _, _, distance, states = cells_around(m, centres, radius)
     return states[distance <= radius]
+
+
+def moved_onto(m: ExplorationMap, before: ExplorationMap, path: np.ndarray, radius: float) -> bool:
+    """Is the disc of ``radius`` along ``path`` blocked in ``m`` only by obstacle cells that were free
+    floor in ``before`` (something moved there since: a person), none unknown or an obstacle then?"""
+    if len(path) == 0:
+        return False
+    centres, _, distance, states = cells_around(m, path, radius)
+    blocking = centres[(distance <= radius) & (states == Cell.OBSTACLE)]
+    return len(blocking) > 0 and bool(np.all(before.cell_state(blocking) == Cell.FREE))
 
 
 def free_travel(m: ExplorationMap, pose: Pose2D, curvature: float, room: float, reach: float) -> float:
@@ -202,13 +219,16 @@ class FollowPath(BearingsBehaviour):
                              "(0: never mind)")
     REACTION = InputPort("reaction", float, 0.2, unit="s", minimum=0.0, maximum=5.0, literal_only=True,
                          doc="from an echo to braking (a tick, the sensors' cycle)")
+    WAIT = InputPort("wait", float, 6.0, unit="s", minimum=0.0, maximum=600.0, literal_only=True,
+                     doc="stopped, wait this long for free floor something moved onto (a person) to clear from a "
+                         "blocked path before giving the goal up")
     RANGES = InputPort("ranges", RangeScan, Ref(RANGES_KEY.path), doc=RANGES_KEY.doc)
     UNSEEN_AHEAD: OutputPort[Pose2D | None] = OutputPort(
         "unseen_ahead", Pose2D, "/robot/unseen_ahead",
         doc="the first point of the path ahead whose disc covers unseen floor (None: none)")
     PORTS = (SPEED, SPEED_LIMIT, TURN_RATE, TOLERANCE, LOOKAHEAD, TURN_IN_PLACE, CHECK_DISTANCE, CLEARANCE,
              ROBOT_RADIUS, FOOTPRINT, MARGIN, PENALTY, BACKOFF, MAX_STALLS, GUARD, STUCK_TIME, UNSEEN_MARGIN, CRAWL,
-             FRONT, APPROACH, REACTION, RANGES, GOAL, MAP, POSE, STALLED, COMMAND, UNSEEN_AHEAD)
+             FRONT, APPROACH, REACTION, RANGES, GOAL, MAP, POSE, STALLED, COMMAND, UNSEEN_AHEAD, WAIT)
     RANGES_OPTIONAL = True  # without range sensors nothing is in the lane: the map's checks alone
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
@@ -223,12 +243,16 @@ class FollowPath(BearingsBehaviour):
         self.safety_stops = 0
         self.blind_stops = 0
         self.stuck = 0
+        self.waits = 0  # times the robot stopped for something that moved onto its path
+        self.clear_map: ExplorationMap | None = None  # the last map on which the path ahead was clear
+        self.waiting_since: float | None = None
         self.progress: tuple[float, float] = (math.inf, 0.0)  # best path length left, and when
         self._drawn: np.ndarray | None = None  # the path last drawn
 
     def initialise(self) -> None:
         self.goal, self.path, self.index, self.stalls = None, np.zeros((0, 2)), 0, 0
         self.backing_until = -math.inf
+        self.clear_map, self.waiting_since = None, None
 
     def command(self, v: float, w: float) -> None:
         self.set_output(COMMAND, VelocityCommand(v, w))
@@ -270,16 +294,22 @@ class FollowPath(BearingsBehaviour):
             self.command(0.0, 0.0)
             self.feedback_message = "at the goal"
             return Status.RUNNING
-        if self._blocked(m):
+        if self._blocked(m, self.path[self.index:]):
             self.replans += 1
             planned = disc_radius(self) + self.get_input(CLEARANCE)
             travel = travel_cost(m, (pose.x, pose.y), planned,
                                  margin=self.get_input(self.MARGIN), penalty=self.get_input(self.PENALTY))
-            self.path, self.index = travel.path_to(goal.target), 0
-            if len(self.path) == 0 or self._blocked(m):
+            path = travel.path_to(goal.target)
+            if len(path) and not self._blocked(m, path):
+                self.path, self.index, self.waiting_since = path, 0, None
+            elif self._moved_onto(m):
+                return self._wait()
+            else:
                 self.command(0.0, 0.0)
                 self.feedback_message = "the goal cannot be reached any more"
                 return Status.FAILURE
+        else:
+            self.clear_map, self.waiting_since = m, None
         self.index = self._nearest(here)
         carrot, remaining = self._carrot(here)
         if remaining < self.progress[0] - 0.05:
@@ -342,14 +372,37 @@ class FollowPath(BearingsBehaviour):
         far = np.flatnonzero(np.hypot(*(ahead - here).T) >= self.get_input(self.LOOKAHEAD))
         return (ahead[far[0]] if len(far) else ahead[-1]), remaining
 
-    def _blocked(self, m: ExplorationMap) -> bool:
-        """Does the path's next ``check_distance`` bring the disc onto an obstacle cell?"""
-        ahead = self.path[self.index :]
+    def _ahead(self, ahead: np.ndarray) -> np.ndarray:
+        """The points of the path ``ahead`` within its first ``check_distance``."""
+        along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ahead, axis=0).T))))
+        return ahead[along <= self.get_input(self.CHECK_DISTANCE)]
+
+    def _blocked(self, m: ExplorationMap, ahead: np.ndarray) -> bool:
+        """Does the path ``ahead``'s first ``check_distance`` bring the disc onto an obstacle cell?"""
         if len(ahead) == 0:
             return False
-        along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ahead, axis=0).T))))
-        near = ahead[along <= self.get_input(self.CHECK_DISTANCE)]
-        return bool(np.any(disc_cells(m, near, disc_radius(self)) == Cell.OBSTACLE))
+        return bool(np.any(disc_cells(m, self._ahead(ahead), disc_radius(self)) == Cell.OBSTACLE))
+
+    def _moved_onto(self, m: ExplorationMap) -> bool:
+        """Was every obstacle cell that blocks the path ahead free floor on the last map on which the
+        way was clear (something moved onto it), rather than unknown or an obstacle then?"""
+        return self.clear_map is not None and moved_onto(m, self.clear_map, self._ahead(self.path[self.index:]),
+                                                         disc_radius(self))
+
+    def _wait(self) -> Status:
+        """Stopped for something that moved onto the path: RUNNING for ``wait`` seconds, then FAILURE."""
+        now = self.now()
+        if self.waiting_since is None:
+            self.waiting_since = now
+            self.waits += 1
+        self.command(0.0, 0.0)
+        self.progress = (self.progress[0], now)  # waiting is not being stuck
+        waited = now - self.waiting_since
+        if waited >= self.get_input(self.WAIT):
+            self.feedback_message = f"the way stayed blocked for {waited:.0f} s: giving the goal up"
+            return Status.FAILURE
+        self.feedback_message = f"something moved onto the path: waiting for it to clear ({waited:.0f} s)"
+        return Status.RUNNING
 
     def _seen_distance(self, m: ExplorationMap, here: np.ndarray) -> float:
         """Distance to the first point of the path ahead (within ``guard``) where the front of the disc
@@ -384,7 +437,7 @@ class FollowPath(BearingsBehaviour):
     def figures(self) -> Iterator[Figure]:
         """The ``exploration`` section's driving part: stalls, re-plans, safety stops."""
         yield from (Figure("exploration", name, value) for name, value in (
-            ("stalls", self.total_stalls), ("replans", self.replans), ("stuck", self.stuck),
+            ("stalls", self.total_stalls), ("replans", self.replans), ("stuck", self.stuck), ("waits", self.waits),
             ("safety_stops", self.safety_stops), ("blind_stops", self.blind_stops)))
 
     def drawings(self) -> Iterator[Drawing]:

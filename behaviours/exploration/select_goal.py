@@ -18,6 +18,7 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
+from behaviours.exploration.follow_path import disc_cells, moved_onto
 from behaviours.exploration.ports import CLEARANCE, MAP, POSE, ROBOT_RADIUS, disc_radius
 from behaviours.footprint import FOOTPRINT
 from behaviours.ports import InputPort, OutputPort
@@ -32,7 +33,7 @@ from maps.exploration.goal import (
     select_goal,
     verification_goal,
 )
-from maps.exploration.grid import ExplorationMap
+from maps.exploration.grid import Cell, ExplorationMap
 from maps.exploration.travel import TravelCost
 from perception.geometry import Pose2D
 
@@ -129,6 +130,7 @@ class SelectGoalPoint(BearingsBehaviour):
             point_clearance=self.get_input(self.POINT_CLEARANCE),
             verify_radius=self.get_input(self.VERIFY_RADIUS), look_back=self.get_input(self.LOOK_BACK),
         )  # fmt: skip
+        self._clear_map: ExplorationMap | None = None  # the last map on which the goal's path was clear
         self._sized = False  # robot_radius 0: the footprint's, known once the tree runs
         self.switch = ModeSwitch()
         self.goal: Goal | None = None
@@ -164,7 +166,7 @@ class SelectGoalPoint(BearingsBehaviour):
         goal, now = self.goal, self.now()
         reached = goal is not None and math.hypot(pose.x - goal.target[0], pose.y - goal.target[1]) <= self.get_input(
             self.REACH)
-        if goal is not None and not reached and now - self.selected_at < self.get_input(self.RESELECT):
+        if goal is not None and not reached and self._keep(m, goal, now):
             return Status.RUNNING
         if reached and goal is not None:
             self.reached += 1
@@ -176,6 +178,7 @@ class SelectGoalPoint(BearingsBehaviour):
         before = self.switch
         # one travel-cost search from here serves the selection and its second chance (DONE selects nothing)
         travel = None if self.switch.mode is Mode.DONE else goal_travel(m, (pose.x, pose.y), self.params)
+        self._clear_map = m  # the map the goal's path is chosen on: clear
         self._select(m, pose, None if reached else goal, travel)
         if self.goal is None and self.avoid:  # a second chance for the abandoned border points
             self.forgiven += self.avoid
@@ -197,6 +200,23 @@ class SelectGoalPoint(BearingsBehaviour):
         g = self.goal
         self.feedback_message = f"{g.mode.value}: to ({g.target[0]:.2f}, {g.target[1]:.2f}), G {g.cost:.2f} m"
         return Status.RUNNING
+
+    def _keep(self, m: ExplorationMap, goal: Goal, now: float) -> bool:
+        """Keep the goal (not reached) without choosing again: it is not time to, or its path is
+        blocked only by what moved onto free floor since it was last clear (a person crossing it, who
+        will walk on; path following waits for them, up to its ``wait``). Its path clear, this map
+        becomes the one to compare with."""
+        if now - self.selected_at < self.get_input(self.RESELECT):
+            return True
+        radius = self.params.robot_radius
+        if self._clear_map is None or not np.any(disc_cells(m, goal.path, radius) == Cell.OBSTACLE):
+            self._clear_map = m
+            return False
+        if not moved_onto(m, self._clear_map, goal.path, radius):
+            return False
+        self.selected_at = now
+        self.feedback_message = "something moved onto the goal's path: keeping the goal while it clears"
+        return True
 
     def _spend(self, goal: Goal) -> None:
         """A goal reached or abandoned: its point spent and its border point avoided, or, for a

@@ -125,6 +125,40 @@ def test_a_wall_across_the_path_fails_the_goal():
     assert harness.behaviour.replans == 1
 
 
+def test_waits_for_someone_who_stepped_onto_the_path_then_drives_on():
+    harness = follow(room(), goal_to(3.0), wait=6.0)
+    assert harness.tick() == Status.RUNNING  # the way is clear: this map is the one to compare with
+    harness.write("/map/exploration", room(wall_at=1.0))  # a person across the corridor, on free floor
+    harness.clock.advance(0.2)
+    assert harness.tick() == Status.RUNNING and harness.read("/robot/command") == STOP
+    assert "waiting for it to clear" in harness.behaviour.feedback_message and harness.behaviour.waits == 1
+    harness.clock.advance(5.7)  # 5.9 s: still waiting
+    assert harness.tick() == Status.RUNNING and harness.read("/robot/command") == STOP
+    harness.write("/map/exploration", room())  # they walked on: the floor seen past them
+    harness.clock.advance(0.2)
+    assert harness.tick() == Status.RUNNING and harness.read("/robot/command").v > 0.0
+    assert report_sections(harness.behaviour)["exploration"]["waits"] == 1
+
+
+def test_gives_the_goal_up_when_the_way_stays_blocked_for_the_wait():
+    harness = follow(room(), goal_to(3.0), wait=6.0)
+    harness.tick()
+    harness.write("/map/exploration", room(wall_at=1.0))
+    harness.tick()
+    harness.clock.advance(6.0)
+    assert harness.tick() == Status.FAILURE and "stayed blocked for 6 s" in harness.behaviour.feedback_message
+    assert harness.read("/robot/command") == STOP
+
+
+def test_a_wall_seen_where_the_floor_was_unknown_fails_at_once():
+    harness = follow(room(unknown_from=0.95), goal_to(3.0), wait=6.0, guard=0.0)
+    harness.tick()
+    harness.write("/map/exploration", room(wall_at=1.0))  # the wall is where nothing was seen before
+    harness.clock.advance(0.2)
+    assert harness.tick() == Status.FAILURE
+    assert harness.behaviour.feedback_message == "the goal cannot be reached any more"
+
+
 def test_an_obstacle_on_the_path_is_driven_around():
     m = room()
     cells = m.cells.copy()
@@ -214,8 +248,8 @@ def test_the_report_keeps_its_shape_and_the_path_is_drawn_when_it_changes():
     harness.write("/map/exploration", ExplorationMap.from_cells(FRAME, cells))
     harness.tick()  # re-planned round the post
     assert node.replans == 1 and [d.entity for d in node.drawings()] == ["odometry_frame/exploration/followed"]
-    assert report_sections(node) == {"exploration": {"stalls": 0, "replans": 1, "stuck": 0, "safety_stops": 0,
-                                                     "blind_stops": 0}}
+    assert report_sections(node) == {"exploration": {"stalls": 0, "replans": 1, "stuck": 0, "waits": 0,
+                                                     "safety_stops": 0, "blind_stops": 0}}
 
 
 def test_approach_speed_stops_in_time_for_someone_walking_towards_the_robot():
