@@ -61,6 +61,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
+import numpy as np
 import py_trees
 from py_trees.common import Status
 
@@ -216,7 +217,8 @@ class Runner:
                                       recording_id=f"{self.mission.name}-seed{self.options.seed}",
                                       timeline=self.clock.timeline, image_rate_hz=self.options.image_rate_hz)
         if self.sensor_log is not None:
-            self.sensor_log.open(mission=self.mission.name, timeline=self.clock.timeline, rate_hz=self.rate_hz)
+            self.sensor_log.open(mission=self.mission.name, timeline=self.clock.timeline, rate_hz=self.rate_hz,
+                                 footprint=self.guard.monitor.config.footprint)
         for name, value in self.mission.values.items():  # inputs are readable at run time: /mission/<name>
             py_trees.blackboard.Blackboard.set(input_key(name), value)
         self.blackboard.set(SAFETY_KEY.path, self.guard.state)
@@ -363,7 +365,8 @@ class Runner:
         nodes = self._node_sections()
         for name, values in nodes.sections.items():
             report.setdefault(name, {}).update(values)
-        report["safety"] = self.guard.log.summary()
+        report["safety"] = {**self.guard.log.summary(),  # and the outline collisions were judged with
+                            "footprint": np.round(self.guard.monitor.config.footprint, 4).tolist()}
         if self.sensor_log is not None:
             report["record"] = self.sensor_log.summary()
         for device in (self.guard.base, self.robot.ptu):

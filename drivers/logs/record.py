@@ -18,9 +18,12 @@ from __future__ import annotations
 
 import contextlib
 import datetime
+import json
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from drivers.interfaces import (
     Base,
@@ -37,7 +40,7 @@ from drivers.interfaces import (
 from drivers.logs import camera_codec, codec, topics
 from drivers.logs import messages as msg
 from drivers.logs.camera_codec import ImageFormat
-from drivers.logs.source import first_line
+from drivers.logs.source import FOOTPRINT, first_line
 from drivers.logs.writer import LogWriter
 from perception.frame import Frame, LandmarkBearings
 from perception.geometry import Pose2D
@@ -70,12 +73,16 @@ class SensorLog:
         """An opener whose keyboard records the keys it reads."""
         return lambda: RecordingKeys(opener(), self)
 
-    def open(self, *, mission: str, timeline: str, rate_hz: float) -> None:
-        """Create the file (its metadata says what was run, when, and how the images are compressed)."""
+    def open(self, *, mission: str, timeline: str, rate_hz: float, footprint: Any = None) -> None:
+        """Create the file (its metadata says what was run, when, how the images are compressed and,
+        given the collision monitor's ``footprint`` polygon, the robot's outline, which a replay
+        judges its safety with: :meth:`~drivers.logs.source.LogContents.footprint`)."""
         started = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
-        self.writer = LogWriter(self.path, metadata={
-            "mission": mission, "timeline": timeline, "rate_hz": f"{rate_hz:g}", "started_utc": started,
-            "images": str(self.images), "times": "seconds on the run's clock since its start"})
+        metadata = {"mission": mission, "timeline": timeline, "rate_hz": f"{rate_hz:g}", "started_utc": started,
+                    "images": str(self.images), "times": "seconds on the run's clock since its start"}
+        if footprint is not None:
+            metadata[FOOTPRINT] = json.dumps(np.round(np.asarray(footprint, dtype=float), 6).tolist())
+        self.writer = LogWriter(self.path, metadata=metadata)
 
     def close(self) -> None:
         if self.writer is not None:

@@ -4,10 +4,16 @@ plain dicts (:class:`LogMessage`), and the one-line :class:`LogError` for a log 
 from __future__ import annotations
 
 import dataclasses
+import json
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
+
+import numpy as np
+
+FOOTPRINT = "footprint"
+"""The metadata entry of the recorded robot's outline: JSON [[x, y], ...], metres in the base frame."""
 
 
 class LogError(Exception):
@@ -37,6 +43,15 @@ class LogContents:
     end_ns: int = 0
     metadata: dict[str, str] = field(default_factory=dict)
     cut: str | None = None
+
+    def footprint(self) -> np.ndarray | None:
+        """The recorded robot's outline (K x 2, base frame) from the metadata; None when the log gives
+        none, or one that is not a polygon (another recorder's log, or an older one of ours)."""
+        try:
+            polygon = np.asarray(json.loads(self.metadata[FOOTPRINT]), dtype=float)
+        except (KeyError, TypeError, ValueError):
+            return None
+        return polygon if polygon.ndim == 2 and polygon.shape[1] == 2 and len(polygon) >= 3 else None
 
     @property
     def duration_s(self) -> float:

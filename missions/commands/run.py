@@ -222,7 +222,9 @@ def _open(args: argparse.Namespace, seed: int, mission: Any) -> tuple[Any, Robot
         if args.record is not None and args.record.resolve() == args.replay.resolve():
             raise InputError([Diagnostic("--record", 0, 0, "would overwrite the log --replay reads")])
         replay = open_replay(args.replay, args.topics, mission)  # exit 2 with what the log lacks
-        return replay, replay.robot, replay.clock(), monitor_config(None, BODIES["p3dx"].footprint)
+        logged = replay.contents.footprint()  # the recorded robot's outline; a P3-DX's when the log gives none
+        footprint = BODIES["p3dx"].footprint if logged is None else logged
+        return replay, replay.robot, replay.clock(), monitor_config(None, footprint)
     if args.robot:
         from missions.profiles import open_robot, robot_safety
 

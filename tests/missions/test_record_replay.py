@@ -67,6 +67,20 @@ def test_the_replay_commanded_what_the_live_run_did(taught):
     assert live["record"]["errors"] == 0 and live["record"]["images"] == "png"
 
 
+def test_the_log_names_the_robots_outline_and_the_replay_judges_with_it(taught):
+    """The lab's robot is the simulator's disc of 0.26 m (a 32-gon round it: corners 0.26 / cos(pi / 32)
+    = 0.26126 m out), not the P3-DX box a replay assumed before; the replay's safety section shows
+    the outline it judged with."""
+    live = json.loads((taught / "live.json").read_text())
+    replayed = json.loads((taught / "replay.json").read_text())
+    outline = np.array(live["safety"]["footprint"])
+    assert outline.shape == (32, 2) and np.allclose(np.hypot(*outline.T), 0.26126, atol=1e-4)
+    assert replayed["safety"]["footprint"] == live["safety"]["footprint"]
+    with open(taught / "run.mcap", "rb") as f:
+        metadata = {m.name: m.metadata for m in make_reader(f).iter_metadata()}["bearings"]
+    assert np.allclose(json.loads(metadata["footprint"]), outline, atol=1e-4)  # the report rounds to 0.1 mm
+
+
 def test_the_replayed_map_takes_follow_route_home(taught):
     report = taught / "follow.json"
     assert run("follow_route", "--sim", "lab", "--set", f"map={taught / 'replay.ltmap'}", "--output-dir", str(taught),
