@@ -33,7 +33,8 @@ plus what the detour needs), or the detour would drive straight back into the co
 way clearing no longer ends the wait (the wish would lead back in too): a detour must start. At
 most :data:`BACKOFFS_PER_HOLD` back-offs per hold; a new hold soon (within ``timeout``) after one,
 near where it began, is the same hold (its clock and back-offs go on), so driving back in and
-backing out cannot go on for ever. The timeout counts on through back-offs.
+backing out cannot go on for ever. The timeout counts on through back-offs, and ends one that
+is still going ("backing away 0.20 m did not free the way").
 
 Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
 without a direction, for ``timeout`` seconds (a hold the motion node's ending cut short, a route
@@ -333,6 +334,10 @@ class Avoidance:
         if episode.last is not None:
             episode.backed += math.hypot(pose.x - episode.last.x, pose.y - episode.last.y)
         episode.last = pose
+        held = episode.origin if episode.detour_start is None else episode.held_since
+        if held is not None and now - held >= self.settings.timeout:  # the hold's timeout counts on while backing
+            return self._give_up(f"blocked for {now - held:.0f} s: backing away {episode.backed:.2f} m did not "
+                                 "free the way", now)
         tx, ty = episode.backing
         command = None
         if math.hypot(tx - pose.x, ty - pose.y) > STEP and episode.backed < 2.0 * self.backoff.distance:

@@ -121,6 +121,26 @@ def test_the_back_offs_of_one_hold_are_counted_and_then_it_gives_up_as_before():
     assert a.tally.reasons[0].startswith("blocked for 20 s by an obstacle")
 
 
+def test_the_holds_timeout_ends_a_back_off_still_going():
+    """Held at t, backing from t + 2 s (the wait) at 0.1 m/s for 0.4 m (4 s): the 3 s timeout comes
+    1 s into the back-off, which it ends (before, the give-up waited for the back-off's end, ~t + 6 s)."""
+    a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=3.0))
+    t = drive_in(a)
+    pose = Pose2D(0.0, 0.0, 0.0)
+    assert a.step(0.3, 0.0, seen(pose), pose, t).phase == "waiting"
+    now = t + 2.0
+    assert a.step(0.3, 0.0, seen(pose), pose, now).phase == "backoff"
+    while True:
+        now += 0.2
+        pose = Pose2D(pose.x - 0.02, 0.0, 0.0)  # it goes back as commanded
+        d = a.step(0.3, 0.0, seen(pose), pose, now)
+        if d.phase != "backoff":
+            break
+    assert d.gave_up and now == pytest.approx(t + 3.0, abs=0.01) and (d.v, d.w) == (0.0, 0.0)
+    assert d.gave_up == "blocked for 3 s: backing away 0.10 m did not free the way"
+    assert a.tally.backoff_length == pytest.approx(0.10, abs=1e-9) and a.phase == "clear"
+
+
 def test_without_a_trail_or_with_back_offs_off_it_stays_held():
     for a in (Avoidance(AVOID, DetourSettings(wait=2.0)),  # never moved: no trail
               Avoidance(AVOID, DetourSettings(wait=2.0), BackoffSettings(distance=0.0))):
