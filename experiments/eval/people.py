@@ -14,7 +14,11 @@ even odds:
   for impossible), or
 - **crossing** it: walking back and forth across it, square to it, up to :data:`CROSSING` m to
   each side (cut where a wall, box or pillar comes nearer than the person's radius), at a speed
-  in :data:`SPEEDS`, waiting up to :data:`WAIT_S` s at each end.
+  in :data:`SPEEDS`, waiting up to :data:`WAIT_S` s at each end. A crossing goes a body's width
+  to each side of the way; a person who finds no place so (a route along a corridor 1.5 m wide,
+  0.5 m on each side of its middle: before, such a route got nobody at all) may cross shorter,
+  half a body's width to each side, when, paused at either end, they leave the robot a way past
+  as a standing person must.
 
 Where "the way" is depends on the area: the taught route (``ltmap``), the straight lines between
 the targets (``roadmap``), or anywhere in the rooms (``exploration``: :func:`in_rooms`, a walker
@@ -185,20 +189,32 @@ def on_ways(world: World, ways: Sequence[np.ndarray], count: int, seed: int, *,
     if not segments:
         return []
     lengths = np.array([arcs[w][i + 1] - arcs[w][i] for _, _, w, i in segments])
-    for _ in range(count):
-        for _ in range(DRAWS):
-            k = int(rng.choice(len(segments), p=lengths / lengths.sum()))
-            a, b, w, i = segments[k]
-            u = rng.uniform()
-            p = a + (b - a) * u
-            around = _on_way(ways[w], arcs[w], arcs[w][i] + u * lengths[k], (-PAST, PAST))
-            walker = _standing_or_crossing(placer, p, (b - a) / lengths[k], around, rng)
-            if walker is not None and placer.keeps_ways(walker):
-                placer.placed.append(walker)
-                if len(walker.path) == 1:
-                    placer.standing.append((p, *around))
+    for person in range(count):
+        # short crossings only for a person no other place was found for (and from a stream of their
+        # own): where the ways leave room, the people are those drawn before short crossings existed
+        for draws, short in ((rng, False), (np.random.default_rng([seed, count, 0x9E0B, person]), True)):
+            if _place_on_ways(placer, ways, arcs, segments, lengths, draws, short=short):
                 break
     return placer.placed
+
+
+def _place_on_ways(placer: _Placer, ways: Sequence[np.ndarray], arcs: list[np.ndarray],
+                   segments: list[tuple[np.ndarray, np.ndarray, int, int]], lengths: np.ndarray,
+                   rng: np.random.Generator, *, short: bool) -> bool:
+    """One person on or across the ways in up to :data:`DRAWS` draws from ``rng``; whether placed."""
+    for _ in range(DRAWS):
+        k = int(rng.choice(len(segments), p=lengths / lengths.sum()))
+        a, b, w, i = segments[k]
+        u = rng.uniform()
+        p = a + (b - a) * u
+        around = _on_way(ways[w], arcs[w], arcs[w][i] + u * lengths[k], (-PAST, PAST))
+        walker = _standing_or_crossing(placer, p, (b - a) / lengths[k], around, rng, short=short)
+        if walker is not None and placer.keeps_ways(walker):
+            placer.placed.append(walker)
+            if len(walker.path) == 1:
+                placer.standing.append((p, *around))
+            return True
+    return False
 
 
 def _on_way(way: np.ndarray, arc: np.ndarray, s: float, offsets: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
@@ -210,7 +226,8 @@ def _on_way(way: np.ndarray, arc: np.ndarray, s: float, offsets: Sequence[float]
 
 
 def _standing_or_crossing(placer: _Placer, p: np.ndarray, along: np.ndarray,
-                          around: tuple[np.ndarray, np.ndarray], rng: np.random.Generator) -> Walker | None:
+                          around: tuple[np.ndarray, np.ndarray], rng: np.random.Generator, *,
+                          short: bool = False) -> Walker | None:
     if rng.uniform() < 0.5:
         return Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) and placer.leaves_a_way(p, *around) else None
     if not placer.apart(p, p):  # the crossing passes through p
@@ -219,8 +236,11 @@ def _standing_or_crossing(placer: _Placer, p: np.ndarray, along: np.ndarray,
     left = placer.reach(p, normal, rng.uniform(*CROSSING))
     right = placer.reach(p, -normal, rng.uniform(*CROSSING))
     a, b = p - right * normal, p + left * normal
-    if min(left, right) < 2 * RADIUS or not placer.fits(a, b):  # a crossing leaves the way on both sides
+    least = RADIUS if short else 2 * RADIUS  # off the way by a body's width (short: half) on both sides
+    if min(left, right) < least or not placer.fits(a, b):
         return None
+    if min(left, right) < 2 * RADIUS and not all(placer.leaves_a_way(end, *around) for end in (a, b)):
+        return None  # a short crossing (a corridor's width): paused at either end, they leave a way past
     first, last = (a, b) if rng.uniform() < 0.5 else (b, a)
     return Walker(((float(first[0]), float(first[1])), (float(last[0]), float(last[1]))),
                   float(rng.uniform(*SPEEDS)), float(rng.uniform(0.0, WAIT_S)))

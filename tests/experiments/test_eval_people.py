@@ -147,11 +147,30 @@ def test_nobody_stands_where_the_robot_cannot_get_past_them(world_file):
     # needs 0.25 + 2 * 0.36 = 0.97 m from the person's centre to one wall: a 1.4 m corridor has 0.7
     way = np.array([[1.0, 0.7], [9.0, 0.7]])
     narrow = load_world(world_file(corridor(1.4)))
-    assert all(on_ways(narrow, [way], 3, seed=s, keep_clear=[way[0], way[-1]]) == [] for s in range(5))
+    assert not any(len(w.path) == 1 for s in range(5) for w in on_ways(narrow, [way], 3, seed=s,
+                                                                       keep_clear=[way[0], way[-1]]))
     wide = load_world(world_file(corridor(2.4), "wide.yaml"))  # 1.2 m to each wall
     clear = [[1.0, 1.2], [9.0, 1.2]]
     placed = [w for s in range(5) for w in on_ways(wide, [way + [0.0, 0.5]], 3, seed=s, keep_clear=clear)]
     assert any(len(w.path) == 1 for w in placed)
+
+
+def test_a_corridor_too_narrow_for_a_body_each_side_gets_short_crossings_that_leave_a_way(world_file):
+    """A 1.4 m corridor: from its middle a person reaches 0.45 m to a wall (their radius off it), less
+    than a body (0.5 m), so no crossing of the usual kind fits and before nobody was placed. Short
+    crossings go at least half a body (0.25 m) to each side; paused at an end (centre 0.25 m from a
+    wall), the person's edge is 0.5 m from it, leaving 0.90 m to the other wall, more than the 0.72 m
+    the robot's disc grown by its clearance needs."""
+    way = np.array([[1.0, 0.7], [9.0, 0.7]])
+    world = load_world(world_file(corridor(1.4)))
+    placer = _Placer(world, keep_clear=[])
+    people = [w for s in range(5) for w in on_ways(world, [way], 3, seed=s, keep_clear=[way[0], way[-1]])]
+    assert len(people) >= 5 and all(len(w.path) == 2 and crosses(way, w) for w in people)
+    for walker in people:
+        for end in np.asarray(walker.path):
+            assert RADIUS - 1e-9 <= distance_to(way, end) < 2 * RADIUS  # short: between half and one body
+            on_way = np.array([end[0], 0.7])
+            assert placer.leaves_a_way(end, on_way - [1.5, 0.0], on_way + [1.5, 0.0])
 
 
 def test_a_person_beside_the_first_closes_one_side_and_a_third_the_last_way_past(world_file):
