@@ -127,13 +127,17 @@ def disc_cells(m: ExplorationMap, centres: np.ndarray, radius: float) -> np.ndar
     return states[distance <= radius]
 
 
-def moved_onto(m: ExplorationMap, before: ExplorationMap, path: np.ndarray, radius: float) -> bool:
-    """Is the disc of ``radius`` along ``path`` blocked in ``m`` only by obstacle cells that were free
-    floor in ``before`` (something moved there since: a person), none unknown or an obstacle then?"""
+def blocking_cells(m: ExplorationMap, path: np.ndarray, radius: float) -> np.ndarray:
+    """The centres (K x 2) of the obstacle cells of ``m`` within ``radius`` of a point of ``path``."""
     if len(path) == 0:
-        return False
+        return np.zeros((0, 2))
     centres, _, distance, states = cells_around(m, path, radius)
-    blocking = centres[(distance <= radius) & (states == Cell.OBSTACLE)]
+    return centres[(distance <= radius) & (states == Cell.OBSTACLE)]
+
+
+def moved_onto(before: ExplorationMap, blocking: np.ndarray) -> bool:
+    """Were the cells ``blocking`` a path (:func:`blocking_cells`), some at least, all free floor in
+    ``before`` (something moved there since: a person), none unknown or an obstacle then?"""
     return len(blocking) > 0 and bool(np.all(before.cell_state(blocking) == Cell.FREE))
 
 
@@ -386,8 +390,8 @@ class FollowPath(BearingsBehaviour):
     def _moved_onto(self, m: ExplorationMap) -> bool:
         """Was every obstacle cell that blocks the path ahead free floor on the last map on which the
         way was clear (something moved onto it), rather than unknown or an obstacle then?"""
-        return self.clear_map is not None and moved_onto(m, self.clear_map, self._ahead(self.path[self.index:]),
-                                                         disc_radius(self))
+        return self.clear_map is not None and moved_onto(
+            self.clear_map, blocking_cells(m, self._ahead(self.path[self.index:]), disc_radius(self)))
 
     def _wait(self) -> Status:
         """Stopped for something that moved onto the path: RUNNING for ``wait`` seconds, then FAILURE."""

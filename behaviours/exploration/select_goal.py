@@ -18,7 +18,7 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.exploration.follow_path import disc_cells, moved_onto
+from behaviours.exploration.follow_path import blocking_cells, moved_onto
 from behaviours.exploration.ports import CLEARANCE, MAP, POSE, ROBOT_RADIUS, disc_radius
 from behaviours.footprint import FOOTPRINT
 from behaviours.ports import InputPort, OutputPort
@@ -33,7 +33,7 @@ from maps.exploration.goal import (
     select_goal,
     verification_goal,
 )
-from maps.exploration.grid import Cell, ExplorationMap
+from maps.exploration.grid import ExplorationMap
 from maps.exploration.travel import TravelCost
 from perception.geometry import Pose2D
 
@@ -208,11 +208,11 @@ class SelectGoalPoint(BearingsBehaviour):
         becomes the one to compare with."""
         if now - self.selected_at < self.get_input(self.RESELECT):
             return True
-        radius = self.params.robot_radius
-        if self._clear_map is None or not np.any(disc_cells(m, goal.path, radius) == Cell.OBSTACLE):
+        blocking = blocking_cells(m, goal.path, self.params.robot_radius)
+        if self._clear_map is None or len(blocking) == 0:
             self._clear_map = m
             return False
-        if not moved_onto(m, self._clear_map, goal.path, radius):
+        if not moved_onto(self._clear_map, blocking):
             return False
         self.selected_at = now
         self.feedback_message = "something moved onto the goal's path: keeping the goal while it clears"
