@@ -73,7 +73,7 @@ class SensorLog:
         """An opener whose keyboard records the keys it reads."""
         return lambda: RecordingKeys(opener(), self)
 
-    def open(self, *, mission: str, timeline: str, rate_hz: float, footprint: Any = None) -> None:
+    def open(self, *, mission: str, timeline: str, rate_hz: float, footprint: np.ndarray | None = None) -> None:
         """Create the file (its metadata says what was run, when, how the images are compressed and,
         given the collision monitor's ``footprint`` polygon, the robot's outline, which a replay
         judges its safety with: :meth:`~drivers.logs.source.LogContents.footprint`)."""
