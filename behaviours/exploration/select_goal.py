@@ -18,7 +18,6 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.exploration.follow_path import blocking_cells, moved_onto
 from behaviours.exploration.ports import CLEARANCE, MAP, POSE, ROBOT_RADIUS, disc_radius
 from behaviours.footprint import FOOTPRINT
 from behaviours.ports import InputPort, OutputPort
@@ -34,6 +33,7 @@ from maps.exploration.goal import (
     verification_goal,
 )
 from maps.exploration.grid import ExplorationMap
+from maps.exploration.queries import blocking_cells, moved_onto
 from maps.exploration.travel import TravelCost
 from perception.geometry import Pose2D
 

@@ -8,12 +8,13 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from behaviours.exploration.follow_path import FollowPath, approach_speed, disc_cells
+from behaviours.exploration.follow_path import FollowPath, approach_speed
 from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP
 from maps.exploration.goal import Goal, Mode
 from maps.exploration.grid import Cell, ExplorationMap, GridFrame
+from maps.exploration.queries import disc_cells
 from perception.geometry import Pose2D
 from perception.ranges import RangeScan, RangeSensor
 
