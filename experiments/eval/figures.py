@@ -6,12 +6,33 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
+from scipy.stats import binomtest
+
+CONFIDENCE = 0.95  # of the interval printed beside a success count
 
 
 def mean_present(values: Sequence[Any]) -> float | None:
     """Mean of the values that are there (None: an episode without that figure); None when none is."""
     present = [float(v) for v in values if v is not None]
     return float(np.mean(present)) if present else None
+
+
+def success_interval(successes: int, trials: int, confidence: float = CONFIDENCE) -> tuple[float, float] | None:
+    """Where the success rate behind ``successes`` of ``trials`` lies, with ``confidence``: the Wilson
+    score interval (None without trials). Five of five seeds says the rate is above 0.57, not that it
+    is 1: a table prints this beside its counts so that nobody reads more into a few seeds."""
+    if trials <= 0:
+        return None
+    ci = binomtest(int(successes), int(trials)).proportion_ci(confidence, method="wilson")
+    return float(ci.low), float(ci.high)
+
+
+def interval_cell(successes: int, trials: int) -> str:
+    """``95 % 0.57-1.00`` for a success count (``-`` without trials)."""
+    interval = success_interval(successes, trials)
+    if interval is None:
+        return "-"
+    return f"{round(100 * CONFIDENCE)} % {interval[0]:.2f}-{interval[1]:.2f}"
 
 
 def cell(value: Any, digits: int = 3) -> str:

@@ -15,7 +15,7 @@ from typing import Any
 
 from behaviours.route import ESTIMATE_RULES
 from experiments.eval import people as crowd
-from experiments.eval.figures import cell, mean_present, safety_cells, safety_totals
+from experiments.eval.figures import cell, interval_cell, mean_present, safety_cells, safety_totals, success_interval
 
 RULE_COLUMNS = {"zinf_1deg": "z1", "zinf_2deg": "z2", "zinf_4deg": "z4", "zinf_8deg": "z8", "compass": "cmp",
                 "no_rotation": "none", "lost": "lost"}
@@ -52,6 +52,7 @@ def row_figures(runs: list[dict[str, Any]]) -> dict[str, Any]:
         "path_error_reached_m": mean_present([r.get("path_error_m") for r in reached]),
         "goal_error_m": mean_present([r.get("goal_error_m") for r in good]),
         "goal_reached": len(reached),
+        "goal_reached_interval": success_interval(len(reached), len(runs)),
         "viewframes_reached_pct": 100.0 * (mean_present([r.get("viewframes_reached") for r in good]) or 0.0),
         "bytes_per_m": mean_present([r.get("bytes_per_m") for r in runs]),
         "estimates_pct": {rule: mean_present([(r.get("estimates_pct") or {}).get(rule) for r in good])
@@ -113,8 +114,10 @@ def format_table(figures: Mapping[str, Any]) -> str:
                      + f"  {safety_cells(row)}" + (f"  ({row['errors']} errors)" if row.get("errors") else ""))
     still, lost = figures.get("goal_reached_down_to_memory_pct"), figures.get("goal_first_missed_memory_pct")
     if figures["rows"]:
+        full = figures["rows"][0]
         lines.append(f"goal reached by every seed down to {cell(still, 1)} % memory; first missed at "
-                     f"{cell(lost, 1)} %")
+                     f"{cell(lost, 1)} %; on the full map {full['goal_reached']} of {full['seeds']}, the rate "
+                     f"{interval_cell(full['goal_reached'], full['seeds'])} (Wilson)")
     lines.append(f"teaching: {safety_cells({k[6:]: v for k, v in figures.items() if k.startswith('teach.')})}")
     lines += crowd.table_line(figures)
     for fail in figures["teach_failed"]:

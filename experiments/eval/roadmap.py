@@ -67,7 +67,7 @@ from drivers.sim.floor import FloorGrid
 from drivers.sim.world import World, load_world
 from experiments.eval import EvalOptions, count_option
 from experiments.eval import people as crowd
-from experiments.eval.figures import cell, mean_present, safety_cells, safety_figures, safety_totals
+from experiments.eval.figures import cell, interval_cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.roadmap_world import (
     place_targets,
     pose_error,
@@ -473,7 +473,8 @@ def format_table(figures: Mapping[str, Any]) -> str:
         f"graph connected {cell(f['graph.connected_rate'], 2)} of the seeds, {cell(f['graph.edges_mean'], 1)} "
         "edges (mean)",
         f"goto reached {f['goto.reached']} of {f['goto.run']} run ({f['goto.planned']} planned, rate "
-        f"{cell(rate, 2)}); error worst {_pair(f['goto.error_worst_m'], f['goto.heading_error_worst_deg'])}, mean "
+        f"{cell(rate, 2)}, {interval_cell(f['goto.reached'], f['goto.run'])}); error worst "
+        f"{_pair(f['goto.error_worst_m'], f['goto.heading_error_worst_deg'])}, mean "
         f"{_pair(f['goto.error_mean_m'], f['goto.heading_error_mean_deg'])}; {safety_cells(_prefixed(f, 'goto.'))}",
         "",
         f"{'seed':>4} {'run':<18} {'status':<8} {'result':<38} {'error':<24} {'sim s':>7} {'wall s':>7}  obstacles",

@@ -312,6 +312,7 @@ def test_the_summary_from_hand_made_runs():
     assert figures["failures"][1]["reason"] == "killed by SIGKILL" and len(figures["runs"]) == 5
     table = format_table(figures)
     assert "targets found 3 of 4" in table and "goto reached 1 of 3 run (4 planned" in table
+    assert "rate 0.33, 95 % 0.06-0.79)" in table  # 1 of 3 says little: the Wilson interval beside it
     assert "seed 0 goto 1 to b: ERROR: killed by SIGKILL" in table
     placed = format_table(summarise("w", Settings(("t1", "t2"), 0, PLACED), learns, [],
                                     {1: {"t1": Pose2D(1.5, 2.25, 0.0), "t2": Pose2D(4.0, 1.0, math.pi)}}))
@@ -319,7 +320,7 @@ def test_the_summary_from_hand_made_runs():
     assert "seed 1 placed targets: t1 (1.5, 2.25, 0 deg), t2 (4, 1, 180 deg)" in placed
     empty = summarise("w", settings, learns[1:], [])
     assert empty["goto.reached_rate"] is None and empty["goto.error_worst_m"] is None
-    assert "goto reached 0 of 0 run" in format_table(empty)
+    assert "goto reached 0 of 0 run" in format_table(empty) and "rate -, -)" in format_table(empty)
 
 
 def test_targets_and_options_are_checked_against_the_world(world_file):
