@@ -16,6 +16,7 @@ from experiments.eval.exploration import (
     check_world,
     episode_figures,
     episodes,
+    format_table,
     pose_errors,
     seen_floor,
     summarise_variant,
@@ -179,3 +180,11 @@ def test_episodes_that_all_fail_are_counted_not_a_crash(tmp_path, capsys):
     for variant in ("method", "baseline", "fixed", "eq1"):
         assert figures[f"{variant}.errors"] == 1 and figures[f"{variant}.ok"] == 0
     assert figures["method_vs_baseline.path_length_ratio"] is None
+
+
+def test_the_table_gives_the_interval_of_each_variants_rate_of_runs_that_met_the_criterion():
+    figures = {"world": "w", "seeds": 6, "reachable_area_m2": 10.0, "criterion": "c",
+               "method.coverage": 0.99, "method.ok": 6, "baseline.coverage": 0.9, "baseline.ok": 3}
+    row = next(line for line in format_table(figures).splitlines() if line.startswith("ok rate, 95 %"))
+    # Wilson, z = 1.96: 6 of 6 from 0.610; 3 of 6 0.5 -+ 0.312 (worked as in test_eval_figures)
+    assert row.split()[-2:] == ["0.61-1.00", "0.19-0.81"]
