@@ -14,7 +14,6 @@ from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP
 from maps.exploration.goal import Goal, Mode
 from maps.exploration.grid import Cell, ExplorationMap, GridFrame
-from maps.exploration.queries import disc_cells
 from perception.geometry import Pose2D
 from perception.ranges import RangeScan, RangeSensor
 
@@ -219,18 +218,6 @@ def test_a_path_with_just_enough_clearance_is_not_blocked():
     cells[rows, cols] = Cell.OBSTACLE  # the jambs: cell centres (1.025, +-0.325) and the path at y 0.025
     harness = follow(ExplorationMap.from_cells(FRAME, cells), goal_to(3.0))
     assert harness.tick() == Status.RUNNING and harness.behaviour.replans == 0
-
-
-def test_disc_cells_are_the_cells_within_the_radius_of_any_centre():
-    m = room(wall_at=1.0)
-    # by hand: a disc of 0.06 m round a cell corner covers the four cells around it (centres 0.035 away)
-    assert sorted(disc_cells(m, np.array([[0.0, 0.0]]), 0.06).tolist()) == [Cell.FREE] * 4
-    # the wall's cells have centres at x 0.975 and 1.025: from (0.9, 0) those at y +-0.025 lie 0.079 m away,
-    # those at y +-0.075 0.106 m
-    assert np.count_nonzero(disc_cells(m, np.array([[0.9, 0.0]]), 0.1) == Cell.OBSTACLE) == 2
-    clear = disc_cells(m, np.array([[0.8, 0.0], [3.95, 0.95]]), 0.1)
-    assert np.count_nonzero(clear == Cell.OBSTACLE) == 0
-    assert np.count_nonzero(clear == Cell.UNKNOWN) > 0  # beyond the grid's corner at (4, 1): unknown
 
 
 def test_the_report_keeps_its_shape_and_the_path_is_drawn_when_it_changes():
