@@ -73,7 +73,7 @@ from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.world import load_world
 from experiments.eval import EvalOptions
 from experiments.eval import people as crowd
-from experiments.eval.figures import safety_figures, safety_totals, success_interval
+from experiments.eval.figures import interval_text, safety_figures, safety_totals, success_interval
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
 from experiments.sweep.table import read_report
@@ -440,6 +440,5 @@ def format_table(figures: dict[str, Any]) -> str:
         lines.append(key.ljust(24) + "".join(cells))
         if key == "ok":  # what so few seeds say about the rate: its 95 % Wilson interval
             intervals = [success_interval(int(figures.get(f"{name}.ok") or 0), int(figures["seeds"])) for name in names]
-            lines.append("ok rate, 95 %".ljust(24) + "".join(
-                ("-" if i is None else f"{i[0]:.2f}-{i[1]:.2f}").rjust(width) for i in intervals))
+            lines.append("ok rate, 95 %".ljust(24) + "".join(interval_text(i).rjust(width) for i in intervals))
     return "\n".join(lines + crowd.table_line(figures))

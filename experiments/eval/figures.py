@@ -27,12 +27,15 @@ def success_interval(successes: int, trials: int, confidence: float = CONFIDENCE
     return float(ci.low), float(ci.high)
 
 
+def interval_text(interval: tuple[float, float] | None) -> str:
+    """``0.57-1.00`` for an interval (``-`` for none)."""
+    return "-" if interval is None else f"{interval[0]:.2f}-{interval[1]:.2f}"
+
+
 def interval_cell(successes: int, trials: int) -> str:
     """``95 % 0.57-1.00`` for a success count (``-`` without trials)."""
     interval = success_interval(successes, trials)
-    if interval is None:
-        return "-"
-    return f"{round(100 * CONFIDENCE)} % {interval[0]:.2f}-{interval[1]:.2f}"
+    return "-" if interval is None else f"{round(100 * CONFIDENCE)} % {interval_text(interval)}"
 
 
 def cell(value: Any, digits: int = 3) -> str:
