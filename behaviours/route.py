@@ -49,6 +49,11 @@ How the paper is read here (where it is vague):
   the lost timer for the whole of a hold was tried and dropped: in the lab with 3 people standing
   on the route the robot then stood 20 s (``timeout``) behind someone again and again (95 s in
   one repeat) and got home no more often (docs/obstacles.md).
+- **Odometry while lost (a departure, off by default).** With ``odometry_reach`` > 0 and a map
+  taught with odometry, lost after a switch, the robot drives on by the taught odometry through the
+  next viewframes' places (:mod:`behaviours.route_anchor` ties the two odometry frames at each
+  switch) until the view is back, and only then counts as lost. Measured no better than vision
+  alone among people (docs/ltmap.md), so the paper's rule is the default.
 - **Rotation.** Z-infinity down a ladder of far thresholds, with a compass as the last resort
   (:func:`perception.viewframe_motion.zinf_motion`; the module doc says why).
 - **Goal.** The switch rule fires within some radius of a viewframe (where ``delta_t`` first falls
@@ -82,6 +87,7 @@ from behaviours.landmark_tree import LTMAP_IN
 from behaviours.motion import COMMAND, ODOMETRY, STALLED
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
+from behaviours.route_anchor import RouteAnchor
 from behaviours.telemetry import Arrows, Drawing, Event, Figure, Plot, Points
 from drivers.interfaces import STOP, VelocityCommand
 from maps.ltmap.tree import LandmarkTree
@@ -123,6 +129,7 @@ class RouteProgress:
     viewframes: int
     switched_at: float
     switches: int = 0
+    anchor: RouteAnchor | None = None  # the tie of the teach's odometry to the repeat's, made at the last switch
 
     @classmethod
     def start(cls, viewframes: int, direction: int, now: float) -> RouteProgress:
@@ -139,13 +146,17 @@ class RouteProgress:
         """Viewframes still to reach, the target included."""
         return max(0, self.viewframes - self.target if self.direction > 0 else self.target + 1)
 
-    def advanced(self, now: float) -> RouteProgress:
-        """The target moved on to the next viewframe in the route's direction."""
-        return replace(self, target=self.target + self.direction, switched_at=now, switches=self.switches + 1)
+    def advanced(self, now: float, anchor: RouteAnchor | None = None) -> RouteProgress:
+        """The target moved on to the next viewframe in the route's direction (``anchor``: made at
+        the viewframe reached; the previous one is kept without it)."""
+        return replace(self, target=self.target + self.direction, switched_at=now, switches=self.switches + 1,
+                       anchor=anchor or self.anchor)
 
     def retargeted(self, target: int, now: float) -> RouteProgress:
-        """Home to ``target`` from now on (the trail was found again there)."""
-        return replace(self, target=int(target), switched_at=now)
+        """Home to ``target`` from now on (the trail was found again there, or a skip moved it past
+        something in the way). The tie to the teach's odometry is dropped: a drive by odometry is
+        for going on along the route, not for the target a recovery chose (the next switch ties again)."""
+        return replace(self, target=int(target), switched_at=now, anchor=None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -157,7 +168,8 @@ class RouteEstimate:
     what steering turns by (NaN when unknown); ``delta_t``: eq. 1 against the viewframe (inf
     without a rotation); ``status``: Z-infinity's (``perception.zinf.ZinfStatus``) or ``"lost"``
     when too few landmarks matched; ``rule``: what made the rotation (a rung of Z-infinity's
-    ladder or the compass, ``perception.viewframe_motion.RULES``; empty when lost).
+    ladder or the compass, ``perception.viewframe_motion.RULES``; empty when lost); ``rotation``:
+    the robot's heading in the viewframe's frame (Z-infinity's rotation, rad; NaN without one).
     """
 
     viewframe: int
@@ -169,6 +181,7 @@ class RouteEstimate:
     error: float
     confidence: float
     rule: str = ""
+    rotation: float = math.nan
 
     @property
     def usable(self) -> bool:
@@ -225,6 +238,18 @@ def _counted_as(estimate: RouteEstimate) -> str:
     return estimate.rule if math.isfinite(estimate.delta_t) else NO_ROTATION
 
 
+ARRIVED = 0.25  # m: a drive by odometry is at the target's place (about a switching radius indoors)
+
+
+@dataclass(frozen=True, slots=True)
+class _OdometryDrive:
+    """A drive by odometry while lost: since when, the last pose and the place driven to (odometry)."""
+
+    since: float
+    last: tuple[float, float]
+    place: tuple[float, float] = (math.nan, math.nan)
+
+
 @register
 class FollowRoute(BearingsBehaviour):
     """Home to the target viewframe with Z-infinity: filtered heading, confidence-scaled speed.
@@ -252,15 +277,25 @@ class FollowRoute(BearingsBehaviour):
                          "AvoidObstacles): too few matches then do not count as lost")
     ROTATION = InputPort("rotation", str, "zinf", choices=("zinf", "compass"),
                          doc="zinf: rotation from far landmarks (the paper); compass: from all (for comparison)")
+    ODOMETRY_REACH = InputPort("odometry_reach", float, 0.0, unit="m", minimum=0.0,
+                               doc="lost for lost_time, drive on by odometry to the target's taught place when it "
+                                   "was taught at most this far from the last viewframe reached (maps with places; "
+                                   "route_anchor.py); 0: lost is lost (the paper)")
+    ODOMETRY_TIME = InputPort("odometry_time", float, 20.0, unit="s", minimum=0.0,
+                              doc="the longest drive by odometry before the trail counts as lost")
     ESTIMATE = OutputPort("estimate", RouteEstimate, ESTIMATE_KEY, doc="the latest estimate against the target")
+    PASSED = OutputPort("passed", RouteProgress, PROGRESS_KEY,
+                        doc="the progress after a target's place was reached by odometry (the next one is driven to)")
     PORTS = (FOLLOW_SPEED, MIN_SPEED, TURN_RATE, HEADING_GAIN, TURN_IN_PLACE, K, MIN_CONFIDENCE, MIN_MATCHES,
-             LOST_TIME, HELD, ROTATION, LTMAP_IN, PROGRESS_IN, OBSERVATION_IN, STALLED, COMMAND, ESTIMATE)
+             LOST_TIME, HELD, ROTATION, ODOMETRY_REACH, ODOMETRY_TIME, LTMAP_IN, PROGRESS_IN, OBSERVATION_IN,
+             ODOMETRY, STALLED, COMMAND, ESTIMATE, PASSED)
 
     def __init__(self, name: str | None = None, **ports: Any) -> None:
         super().__init__(name=name, **ports)
         self.matches: LandmarkMatches | None = None  # the latest, for the recording
         self.estimate: RouteEstimate | None = None
         self.rules = dict.fromkeys(ESTIMATE_RULES, 0)  # estimates by the rule that made them, over the run
+        self.drives = {"started": 0, "found": 0, "passed": 0, "metres": 0.0}  # drives by odometry while lost
         self._rng = np.random.default_rng(0)
         self._reset()
 
@@ -270,6 +305,7 @@ class FollowRoute(BearingsBehaviour):
         self._stamp: float | None = None
         self._lost_since: float | None = None
         self._command = self._coast = STOP
+        self._drive: _OdometryDrive | None = None
 
     def initialise(self) -> None:
         self._reset()
@@ -295,11 +331,14 @@ class FollowRoute(BearingsBehaviour):
             self.rules[_counted_as(self.estimate)] += 1
             self.set_output(self.ESTIMATE, self.estimate)
             self._command = self._steer(self.estimate)
-        return self._lost_or_follow()
+        return self._lost_or_follow(tree, progress)
 
-    def _lost_or_follow(self) -> Status:
+    def _lost_or_follow(self, tree: LandmarkTree, progress: RouteProgress) -> Status:
         estimate = self.estimate
         if estimate is not None and estimate.usable:
+            if self._drive is not None:  # the view is back: found by odometry
+                self.drives["found"] += 1
+                self._drive = None
             self._lost_since = None
             self._coast = self._command
             self.set_output(COMMAND, self._command)
@@ -316,13 +355,60 @@ class FollowRoute(BearingsBehaviour):
         else:
             self._lost_since = now if self._lost_since is None else self._lost_since
             if now - self._lost_since >= self.get_input(self.LOST_TIME):
-                return self._stop(Status.FAILURE)
+                command = self._by_odometry(tree, progress, now)
+                if command is None:
+                    return self._stop(Status.FAILURE)
+                self.set_output(COMMAND, command)
+                return Status.RUNNING
         self.set_output(COMMAND, self._coast)  # a short gap: keep on as before (STOP before any estimate)
         return Status.RUNNING
 
     def _stop(self, status: Status) -> Status:
         self.set_output(COMMAND, STOP)
         return status
+
+    def _by_odometry(self, tree: LandmarkTree, progress: RouteProgress, now: float) -> VelocityCommand | None:
+        """Towards the target's taught place, by odometry from the last switch (route_anchor.py),
+        and on through the next places while still blind; None when there is no place to go to
+        (none within ``odometry_reach`` of the viewframe reached), at the route's last viewframe's
+        place (the goal is for vision to confirm), or after ``odometry_time``."""
+        pose = self.get_input(ODOMETRY, None)
+        place = self._odometry_place(tree, progress)
+        if pose is None or place is None:
+            return None
+        if self._drive is None:
+            self._drive = _OdometryDrive(now, (pose.x, pose.y))
+            self.drives["started"] += 1
+        self.drives["metres"] += math.dist(self._drive.last, (pose.x, pose.y))
+        self._drive = replace(self._drive, last=(pose.x, pose.y))
+        if now - self._drive.since > self.get_input(self.ODOMETRY_TIME):
+            return None
+        while math.dist(place, (pose.x, pose.y)) < ARRIVED:  # at the target's place: on to the next one
+            if progress.remaining <= 1:
+                return None
+            ahead = progress.advanced(now)  # the tie stays the last switch's
+            place = self._odometry_place(tree, ahead)
+            if place is None:
+                return None
+            progress = ahead
+            self.set_output(self.PASSED, progress)
+            self.drives["passed"] += 1
+        self._drive = replace(self._drive, place=(float(place[0]), float(place[1])))
+        distance = math.dist(place, (pose.x, pose.y))
+        self.feedback_message += f", driving by odometry to viewframe {progress.target}'s place, {distance:.1f} m"
+        speed = min(self.get_input(FOLLOW_SPEED), max(self.get_input(self.MIN_SPEED), distance))
+        return self._toward(wrap_angle(math.atan2(place[1] - pose.y, place[0] - pose.x) - pose.theta), speed)
+
+    def _odometry_place(self, tree: LandmarkTree, progress: RouteProgress) -> np.ndarray | None:
+        """The target's taught place in this run's odometry frame, when the map has places, a
+        switch tied the frames and the place lies within ``odometry_reach`` of the viewframe reached."""
+        anchor = progress.anchor
+        if anchor is None or not tree.has_places or not 0 <= progress.target < tree.viewframe_count:
+            return None
+        reached, target = tree.place(anchor.viewframe), tree.place(progress.target)
+        if reached is None or target is None or math.dist(reached, target) > self.get_input(self.ODOMETRY_REACH):
+            return None
+        return anchor.to_odometry(reached, target)
 
     def _estimate(self, tree: LandmarkTree, target: int, observation: Observation) -> RouteEstimate:
         matches = self.matches = tree.match(target, observation)
@@ -344,29 +430,41 @@ class FollowRoute(BearingsBehaviour):
             home = -motion.translation  # towards the viewframe, in its frame
             self._filter = self._filter.push(math.atan2(home[1], home[0]), motion.confidence)
         heading = self._filter.heading  # eqs. 7-8: circular median of the last K
+        rotation = wrap_angle(-motion.yaw)  # the robot's heading in the viewframe's frame
         if heading is None:
-            return RouteEstimate(target, observation.stamp, len(matches), status, change, nan, nan, 0.0, rule)
-        error = wrap_angle(heading + motion.yaw)  # the robot's heading in the viewframe's frame is -yaw
+            return RouteEstimate(target, observation.stamp, len(matches), status, change, nan, nan, 0.0, rule,
+                                 rotation)
+        error = wrap_angle(heading + motion.yaw)  # heading - rotation
         return RouteEstimate(target, observation.stamp, len(matches), status, change, heading, error,
-                             self._filter.confidence, rule)
+                             self._filter.confidence, rule, rotation)
 
     def _steer(self, estimate: RouteEstimate) -> VelocityCommand:
         if not estimate.usable:
             return STOP
-        error, turn = estimate.error, math.radians(self.get_input(TURN_RATE))
+        speed = scaled_velocity(estimate.confidence, self.get_input(FOLLOW_SPEED),
+                                min_confidence=self.get_input(self.MIN_CONFIDENCE))  # eq. 9
+        return self._toward(estimate.error, max(self.get_input(self.MIN_SPEED), speed))
+
+    def _toward(self, error: float, speed: float) -> VelocityCommand:
+        """Turn by ``error`` (rad): on the spot above ``turn_in_place``, else at ``speed`` times its cosine."""
+        turn = math.radians(self.get_input(TURN_RATE))
         w = float(np.clip(self.get_input(self.HEADING_GAIN) * error, -turn, turn))
         if abs(error) > math.radians(self.get_input(self.TURN_IN_PLACE)):
             return VelocityCommand(0.0, w)
-        speed = scaled_velocity(estimate.confidence, self.get_input(FOLLOW_SPEED),
-                                min_confidence=self.get_input(self.MIN_CONFIDENCE))  # eq. 9
-        v = max(self.get_input(self.MIN_SPEED), speed) * math.cos(error)
-        return VelocityCommand(v, w)
+        return VelocityCommand(speed * math.cos(error), w)
 
     def figures(self) -> Iterator[Figure]:
         """Every estimate counted by the rule that made it (``estimates.zinf_1deg`` ..
-        ``estimates.compass``), or as ``no_rotation`` (no rule found one) or ``lost`` (too few matches)."""
+        ``estimates.compass``), or as ``no_rotation`` (no rule found one) or ``lost`` (too few matches);
+        the drives by odometry while lost (``odometry_drives``), those that found the view again
+        (``found_by_odometry``), the viewframes' places passed on the way (``passed_by_odometry``)
+        and their length (``odometry_m``)."""
         for rule, count in self.rules.items():
             yield Figure("ltmap", f"estimates.{rule}", count)
+        yield Figure("ltmap", "odometry_drives", self.drives["started"])
+        yield Figure("ltmap", "found_by_odometry", self.drives["found"])
+        yield Figure("ltmap", "passed_by_odometry", self.drives["passed"])
+        yield Figure("ltmap", "odometry_m", round(self.drives["metres"], 2))
 
     def drawings(self) -> Iterator[Drawing]:
         """While following: the target, matches, ``delta_t`` (capped at 1) and confidence as plots,
@@ -381,6 +479,9 @@ class FollowRoute(BearingsBehaviour):
         if estimate.usable:
             direction = np.array([[math.cos(estimate.error), math.sin(estimate.error)]])
             yield Arrows("route/robot_frame/direction", direction, colours=(255, 80, 0))
+        if self._drive is not None and not estimate.usable:
+            yield Points("odometry_frame/route/odometry_target", np.array([self._drive.place]), colours=(255, 0, 200),
+                         radius=0.08)
         if self.matches is not None and len(self.matches):
             cur = np.asarray(self.matches.cur)
             azimuth = np.arctan2(cur[:, 1], cur[:, 0])
@@ -449,9 +550,12 @@ class ViewframeSwitch(BearingsBehaviour):
         now = self.now()
         self.reached.append({"viewframe": progress.target, "time_s": round(now, 3), "rule": rule})
         pose = self.get_input(ODOMETRY, None)
+        anchor = None
         if pose is not None:
             self._reached_at.append([pose.x, pose.y])
-        advanced = progress.advanced(now)
+            if math.isfinite(estimate.rotation):  # ties the teach's odometry to this one (route_anchor.py)
+                anchor = RouteAnchor(progress.target, pose, estimate.rotation)
+        advanced = progress.advanced(now, anchor)
         self.set_output(self.ADVANCED, advanced)
         self._heading = None
         return Status.SUCCESS if advanced.finished else Status.RUNNING

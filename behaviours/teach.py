@@ -38,7 +38,6 @@ from maps.ltmap.learner import LearnConfig, LearnStep, RouteLearner
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
 from maps.ltmap.tree import DEFAULT_THRESHOLD
 from maps.store import InputError
-from perception.geometry import Pose2D
 from perception.observation import Observation
 
 
@@ -71,7 +70,6 @@ class LearnRoute(BearingsDecorator):
                                   gap_filling=self.get_input(self.GAP_FILLING))
         self.learner = RouteLearner(self.config)
         self.taught: list[float] = []  # per viewframe, the tree time it was made
-        self.places: list[list[float]] = []  # per viewframe, the odometry (x, y) it was made at (recording)
         self.prunes = 0
         self.shifted = 0  # landmarks found again and merged into a common node (gap filling)
         self.loops: list[dict[str, int | list[int]]] = []  # viewframe pairs where the route came back
@@ -83,7 +81,7 @@ class LearnRoute(BearingsDecorator):
 
     def initialise(self) -> None:
         self.learner = RouteLearner(self.config)
-        self.taught, self.places, self.prunes, self.saved, self._stamp = [], [], 0, False, None
+        self.taught, self.prunes, self.saved, self._stamp = [], 0, False, None
         self.shifted, self.loops, self.closures, self._looping = 0, [], 0, False
 
     def update(self) -> Status:
@@ -104,9 +102,10 @@ class LearnRoute(BearingsDecorator):
         if observation is None or pose is None or observation.stamp == self._stamp:
             return
         self._stamp = observation.stamp
-        self._record(self.learner.observe(observation, pose.theta), pose)  # bearings compensated by the heading
+        # bearings compensated by the heading; the viewframe keeps where odometry put it
+        self._record(self.learner.observe(observation, pose.theta, (pose.x, pose.y)))
 
-    def _record(self, step: LearnStep, pose: Pose2D) -> None:
+    def _record(self, step: LearnStep) -> None:
         self.shifted += step.shifted
         if step.loop is not None:
             self.loops.append({"viewframes": [step.loop.earlier, step.loop.later], "shared": step.loop.shared})
@@ -120,21 +119,18 @@ class LearnRoute(BearingsDecorator):
                 if new >= 0:
                     kept.setdefault(new, old)
             self.taught = [self.taught[kept[k]] for k in sorted(kept)]
-            self.places = [self.places[kept[k]] for k in sorted(kept)]
         if step.created:
             self.taught.append(round(self.now(), 3))
-            self.places.append([pose.x, pose.y])
         tree = self.learner.tree
         if tree is not None and (step.created or step.pruned is not None):
             self.set_output(LTMAP_OUT, tree)
-            self.taught, self.places = self.taught[:tree.viewframe_count], self.places[:tree.viewframe_count]
+            self.taught = self.taught[:tree.viewframe_count]
 
     def _finish(self) -> Status:
         if self.learner.tree is None:
             self.feedback_message = "nothing was observed: there is no route to save"
             return Status.FAILURE
-        pose = self.get_input(ODOMETRY, Pose2D())
-        self._record(self.learner.finish(), pose)
+        self._record(self.learner.finish())
         tree = self.learner.tree
         path = self.get_input(self.PATH)
         if path:
@@ -164,6 +160,9 @@ class LearnRoute(BearingsDecorator):
 
     def drawings(self) -> Iterator[Drawing]:
         """The viewframes made so far, where odometry put them (when there are new ones)."""
-        if len(self.places) != self._logged and self.places:
-            self._logged = len(self.places)
-            yield Points("odometry_frame/route/viewframes", np.array(self.places), colours=(255, 200, 0), radius=0.05)
+        tree = self.learner.tree
+        if tree is None or not tree.has_places or tree.viewframe_count == self._logged:
+            return
+        self._logged = tree.viewframe_count
+        places = np.array([tree.place(i) for i in range(tree.viewframe_count)])
+        yield Points("odometry_frame/route/viewframes", places, colours=(255, 200, 0), radius=0.05)

@@ -94,6 +94,8 @@ OPTIONS = {
                       "(default: the robot's diameter or the taught viewframes' spacing, whichever is larger)",
     "rotation": "how the repeat estimates its rotation: zinf (Z-infinity, the paper; default) or compass (the "
                 "median bearing change of every landmark: the comparison for worlds with near landmarks)",
+    "odometry": "off (default: the paper) or on: a repeat lost after reaching a viewframe drives by the taught "
+                "odometry through the next places, up to 4 m on, before it counts as lost (follow_route's 'odometry')",
     "cuts": "repeat from the full map and at most this many levels cut (default: every level down to one; 0: "
             "the full map alone, e.g. to measure obstacles or people in a quarter of the time)",
     crowd.OPTION: crowd.HELP + " (the repeats': on the taught route or across it)",
@@ -104,6 +106,7 @@ TOUR, BACK = "tour", "back"
 ON_OFF = {"on": True, "off": False}
 CAMERA_KINDS = ("panorama", "bearings")
 SMALL_VIEWFRAME = 2 * DEFAULT_MIN_LANDMARKS  # landmarks: below this, min_landmarks is half the median viewframe
+ODOMETRY_REACH = 4.0  # m: follow_route's 'odometry' with --option odometry=on
 REPEAT_TIME = (120.0, 4.0)  # s: a repeat's --max-time = a + b * the teach's sim time
 MAPS = "maps"
 
@@ -120,6 +123,7 @@ class Settings:
     gap_filling: bool = True  # LearnRoute's gap filling (maps.ltmap.gaps)
     people: int = 0  # people in the repeats' world
     cuts: int | None = None  # at most this many levels cut (None: every level)
+    odometry: bool = False  # FollowRoute drives by the taught odometry while lost
 
 
 def check_world(world: str) -> World:
@@ -153,16 +157,21 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     rotation = extra.get("rotation", "zinf")
     if rotation not in ROTATIONS:
         raise ValueError(f"rotation must be one of {', '.join(ROTATIONS)}, got {rotation!r}")
-    gap_filling = extra.get("gap_filling", "on")
-    if gap_filling not in ON_OFF:
-        raise ValueError(f"gap_filling must be on or off, got {gap_filling!r}")
     cuts = None
     if "cuts" in extra:
         cuts = _number(extra["cuts"], "cuts", int)
         if cuts < 0:
             raise ValueError(f"cuts must be >= 0 (0: the full map alone), got {cuts}")
-    return Settings(camera, route, min_landmarks, tolerance, rotation, ON_OFF[gap_filling],
-                    crowd.parse_people(extra.get(crowd.OPTION)), cuts)
+    return Settings(camera, route, min_landmarks, tolerance, rotation, _on_off(extra, "gap_filling"),
+                    crowd.parse_people(extra.get(crowd.OPTION)), cuts, _on_off(extra, "odometry", "off"))
+
+
+def _on_off(extra: Mapping[str, str], name: str, default: str = "on") -> bool:
+    """An on/off option; ``ValueError`` for anything else."""
+    value = extra.get(name, default)
+    if value not in ON_OFF:
+        raise ValueError(f"{name} must be on or off, got {value!r}")
+    return ON_OFF[value]
 
 
 def _route(world: World, text: str) -> Route:
@@ -235,7 +244,8 @@ def teach_episode(world: str, seed: int, settings: Settings, folder: Path, max_t
 
 
 def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_landmarks: int,
-                   max_time_s: float | None, rotation: str = "zinf", world: str | None = None) -> Episode:
+                   max_time_s: float | None, rotation: str = "zinf", world: str | None = None,
+                   odometry: bool = False) -> Episode:
     """The repeat of ``teach``'s map cut by ``level.cut`` levels, from the teach's true end pose, in
     ``world`` (default: the teach's)."""
     end = report["ground_truth"]["final_pose"]
@@ -246,6 +256,8 @@ def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_
         inputs["budget"] = level.bytes
     if rotation != "zinf":  # only when not the default: the ids of earlier results stay what they were
         inputs["rotation"] = rotation
+    if odometry:  # only when not the default: the ids of earlier results stay what they were
+        inputs["odometry"] = ODOMETRY_REACH
     if max_time_s is None:
         a, b = REPEAT_TIME
         max_time_s = float(math.ceil((a + b * float(report.get("sim_time_s", 0.0))) / 10.0) * 10.0)
@@ -395,7 +407,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
                            "loop_closures": report.get("ltmap", {}).get("loop_closures"),
                            "sim_time_s": report.get("sim_time_s"), **safety_figures(report)})
         plan += [(follow_episode(teach, report, level, minimum, options.max_time_s, settings.rotation,
-                                 repeat_world[seed]), taught, level)
+                                 repeat_world[seed], settings.odometry), taught, level)
                  for level in levels(tree, minimum)[:None if settings.cuts is None else settings.cuts + 1]]
     if plan:  # every repeat at once: the pool runs them in parallel
         run_sweep([episode for episode, _, _ in plan], executor=options.executor, results_dir=folder,
@@ -419,6 +431,7 @@ def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dic
         "world": world.name,
         "camera": settings.camera,
         "rotation": settings.rotation,
+        "odometry": settings.odometry,
         "seeds": seeds,
         "route_source": settings.route.source,
         "route_length_m": settings.route.length_m,

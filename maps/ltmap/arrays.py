@@ -3,13 +3,16 @@
 A map is plain arrays (:meth:`maps.ltmap.tree.LandmarkTree.to_arrays`, what a map file holds
 besides its header): ``descriptors`` (N x W) or ``ids`` (N,), ``bearings`` (N x 3 float32),
 ``node_parent`` and ``node_size`` (M, int32; the root's parent is -1), ``viewframe_leaf``
-(V, int32, route order). Nodes are in preorder with children in route order (:func:`preorder`)
-and landmarks grouped by node, so equal maps give equal arrays.
+(V, int32, route order) and, when the teach recorded them, ``viewframe_place`` (V x 2 float32:
+where odometry put each viewframe, in the teach's odometry frame, metres). Nodes are in preorder
+with children in route order (:func:`preorder`) and landmarks grouped by node, so equal maps give
+equal arrays.
 
 - **Memory** (``memory_bytes``) is exactly what these arrays hold: per landmark its descriptor
   row (32 bytes for ORB) or id (8 bytes) and its unit bearing (3 x float32, 12 bytes); per node
   its parent and its landmark count (2 x int32, :data:`NODE_BYTES`); per viewframe its leaf
-  (int32, :data:`VIEWFRAME_BYTES`). Landmarks are stored grouped by node, so a landmark's node
+  (int32, :data:`VIEWFRAME_BYTES`), and its place when the map has places (2 x float32,
+  :data:`PLACE_BYTES`). Landmarks are stored grouped by node, so a landmark's node
   costs nothing. Caches and the learner's bookkeeping are not map content.
 
 :func:`checked_arrays` reads them back from a file: a ``ValueError`` naming the first
@@ -30,6 +33,9 @@ INDEX_DTYPE = np.int32
 ID_DTYPE = np.int64
 NODE_BYTES = 2 * np.dtype(INDEX_DTYPE).itemsize  # parent + landmark count
 VIEWFRAME_BYTES = np.dtype(INDEX_DTYPE).itemsize  # the viewframe's leaf
+PLACE_DTYPE = np.float32
+PLACE_BYTES = 2 * np.dtype(PLACE_DTYPE).itemsize  # a viewframe's (x, y) in the teach's odometry frame
+PLACES = "viewframe_place"
 STRUCTURE_ARRAYS = ("bearings", "node_parent", "node_size", "viewframe_leaf")
 
 
@@ -107,16 +113,28 @@ class MapArrays:
     node_parent: np.ndarray
     node_size: np.ndarray
     viewframe_leaf: np.ndarray
+    viewframe_place: np.ndarray | None = None
 
 
 def checked_arrays(arrays: Mapping[str, np.ndarray], kind: str) -> MapArrays:
     """The arrays of a ``kind`` map, checked whole; ``ValueError`` naming the first inconsistency."""
-    unknown = sorted(set(arrays) - {data_name(kind), *STRUCTURE_ARRAYS})
+    unknown = sorted(set(arrays) - {data_name(kind), *STRUCTURE_ARRAYS, PLACES})
     if unknown:
         raise ValueError(f"unexpected arrays for a {kind} map: {', '.join(unknown)}")
     data = _checked_data(arrays, kind)
     bearings = _checked_bearings(arrays, len(data))
-    return MapArrays(data, bearings, *_checked_structure(arrays, len(data)))
+    parent, size, leaves = _checked_structure(arrays, len(data))
+    return MapArrays(data, bearings, parent, size, leaves, _checked_places(arrays, len(leaves)))
+
+
+def _checked_places(arrays: Mapping[str, np.ndarray], count: int) -> np.ndarray | None:
+    if PLACES not in arrays:
+        return None  # a map taught without odometry, or written before places were kept
+    places = np.asarray(arrays[PLACES])
+    if places.shape != (count, 2) or places.dtype != PLACE_DTYPE or not np.all(np.isfinite(places)):
+        raise ValueError(f"viewframe_place must be {count} x 2 finite float32 (one per viewframe), got "
+                         f"{places.dtype} {places.shape}")
+    return places.copy()
 
 
 def _checked_data(arrays: Mapping[str, np.ndarray], kind: str) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""LT-map files: a :class:`~maps.ltmap.tree.LandmarkTree` saved as map kind ``ltmap``, format version 2.
+"""LT-map files: a :class:`~maps.ltmap.tree.LandmarkTree` saved as map kind ``ltmap``, format version 3.
 
 The container (magic line, JSON header with length and SHA-256, ``.npz`` payload, atomic write)
 is :mod:`maps.mapfile`'s; the payload holds exactly :meth:`LandmarkTree.to_arrays`, so a map's
@@ -8,6 +8,9 @@ following switches viewframes at the same value) and eq. 1's scale ``b``. Versio
 a threshold of the earlier form of eq. 1 (the Pseudo-Huber cost of the angle, delta 2 deg) and
 no scale: they are read with the eq. 1 threshold of the same bearing change
 (:func:`perception.similarity.angle_form_threshold_angle`; 1e-3 becomes the cost of 3.04 deg).
+Version 3 adds the viewframes' places (``viewframe_place``: where the teach's odometry put each
+viewframe; route following drives by them while people hide the view, docs/ltmap.md); version 1
+and 2 files are read as maps without places.
 A damaged, truncated, foreign or inconsistent
 file is one :class:`~maps.store.InputError` line, and a failed save leaves the previous file.
 """
@@ -25,8 +28,9 @@ from maps.store import Diagnostic, InputError
 from perception.similarity import DEFAULT_SCALE, angle_form_threshold_angle, cost_of_angle
 
 KIND = "ltmap"
-VERSION = 2
+VERSION = 3
 ANGLE_FORM_VERSION = 1  # thresholds of the earlier form of eq. 1, read converted
+READABLE = (ANGLE_FORM_VERSION, 2, VERSION)  # 2: no viewframe places
 
 
 class LtmapMeta(BaseModel):
@@ -55,12 +59,12 @@ def save_ltmap(path: str | os.PathLike, tree: LandmarkTree) -> None:
 
 def decode_ltmap(data: bytes, *, file: str) -> LandmarkTree:
     """An LT-map from file bytes; one-line :class:`InputError` naming ``file`` when they are not one."""
-    return _tree(decode_map(data, file=file, kind=KIND, versions=(ANGLE_FORM_VERSION, VERSION)), file)
+    return _tree(decode_map(data, file=file, kind=KIND, versions=READABLE), file)
 
 
 def load_ltmap(path: str | os.PathLike) -> LandmarkTree:
     """Load an LT-map file, checking container, header and the tree's consistency."""
-    return _tree(read_map_file(path, kind=KIND, versions=(ANGLE_FORM_VERSION, VERSION)), str(path))
+    return _tree(read_map_file(path, kind=KIND, versions=READABLE), str(path))
 
 
 def _tree(loaded: MapFile, file: str) -> LandmarkTree:

@@ -133,6 +133,7 @@ class LearnStep:
 class _Seen:
     observation: Observation
     bearings: np.ndarray  # route frame
+    place: tuple[float, float] | None = None  # odometry (x, y) it was seen at
 
 
 @dataclass(frozen=True, slots=True)
@@ -174,11 +175,14 @@ class RouteLearner:
         self.threshold = self.config.eq1_threshold
         self.share_angle = threshold_angle(self.threshold, self.config.scale) if angle is None else angle
 
-    def observe(self, observation: Observation, heading: float) -> LearnStep:
-        """One new observation, seen with the camera at ``heading`` (rad) in the route frame."""
+    def observe(self, observation: Observation, heading: float, place: tuple[float, float] | None = None
+                ) -> LearnStep:
+        """One new observation, seen with the camera at ``heading`` (rad) in the route frame, at
+        ``place`` (odometry x, y; the viewframe it makes keeps it: :meth:`LandmarkTree.place`).
+        Give a place with every observation or with none."""
         if self.tree is None:
             self.tree = LandmarkTree(_kind_of(observation), threshold=self.threshold, scale=self.config.scale)
-        tree, seen = self.tree, _Seen(observation, compensate(observation.bearings, heading))
+        tree, seen = self.tree, _Seen(observation, compensate(observation.bearings, heading), place)
         self._before, self._latest = self._latest, seen
         if tree.viewframe_count == 0:
             self._at_viewframe = self._before is not None  # the first viewframe needs a previous image
@@ -233,7 +237,7 @@ class RouteLearner:
         before = tree.landmark_count
         sightings = LandmarkSet.from_observation(seen.observation, seen.bearings, features)
         tree.add_viewframe(landmarks, sightings, LandmarkSet.from_observation(seen.observation, seen.bearings, new),
-                           share_angle=self.share_angle)
+                           share_angle=self.share_angle, place=seen.place)
         stored = np.arange(before, tree.landmark_count)
         self._anchor = _Anchor(np.concatenate((landmarks, stored)),
                                np.vstack((sightings.bearings, tree.bearings[stored])))

@@ -61,6 +61,9 @@ from maps.ltmap.arrays import (
     IDS,
     INDEX_DTYPE,
     NODE_BYTES,
+    PLACE_BYTES,
+    PLACE_DTYPE,
+    PLACES,
     VIEWFRAME_BYTES,
     check_kind,
     checked_arrays,
@@ -174,6 +177,19 @@ def _resolve(index: np.ndarray, alive: np.ndarray) -> np.ndarray:
     return out
 
 
+def _carried_places(places: list[tuple[float, float]] | None, viewframe_index: np.ndarray
+                    ) -> list[tuple[float, float]] | None:
+    """The places after a cut: a kept viewframe keeps the place of the earliest viewframe merged
+    into it (``viewframe_index``: each old viewframe's new index, -1 when deleted)."""
+    if places is None:
+        return None
+    kept: dict[int, tuple[float, float]] = {}
+    for old, new in enumerate(np.asarray(viewframe_index).tolist()):
+        if new >= 0:
+            kept.setdefault(new, places[old])
+    return [kept[k] for k in sorted(kept)]
+
+
 @dataclass
 class _Rows:
     """The landmark rows of a tree (mutable storage): node, unit bearing, and ``data``, the
@@ -209,6 +225,7 @@ class LandmarkTree:
         self.scale = float(scale)  # eq. 1's b: delta_t against ``threshold`` is measured with it
         self._parent: list[int] = []
         self._leaves: list[int] = []
+        self._places: list[tuple[float, float]] | None = None  # per viewframe, where teach odometry put it
         self._rows = _Rows(np.zeros(0, dtype=np.int64), np.zeros((0, 3), dtype=BEARING_DTYPE), empty_data(kind))
         self._cache = ViewframeCache()
 
@@ -240,7 +257,8 @@ class LandmarkTree:
         """Bytes of the map's content: exactly the ``nbytes`` of :meth:`to_arrays` (see :mod:`maps.ltmap.arrays`)."""
         data = self._rows.data
         row = 3 * np.dtype(BEARING_DTYPE).itemsize + int(np.prod(data.shape[1:], dtype=np.int64)) * data.itemsize
-        return self.landmark_count * row + self.node_count * NODE_BYTES + self.viewframe_count * VIEWFRAME_BYTES
+        per_viewframe = VIEWFRAME_BYTES + (PLACE_BYTES if self._places is not None else 0)
+        return self.landmark_count * row + self.node_count * NODE_BYTES + self.viewframe_count * per_viewframe
 
     def depths(self) -> np.ndarray:
         """Depth of every node (root 0)."""
@@ -309,6 +327,19 @@ class LandmarkTree:
             node = self._parent[node]
         return tuple(reversed(chain))
 
+    @property
+    def has_places(self) -> bool:
+        """The map knows where each viewframe was taught (teach odometry); False for maps taught
+        without odometry or read from files written before places were kept (version 2)."""
+        return self._places is not None
+
+    def place(self, index: int) -> np.ndarray | None:
+        """Where viewframe ``index`` was taught: (x, y) in the teach's odometry frame (m), None
+        when the map has no places."""
+        if self._places is None:
+            return None
+        return np.array(self._places[index], dtype=float)
+
     def viewframe(self, index: int, *, cached: bool = True) -> Viewframe:
         """The landmarks of viewframe ``index`` (negative: from the goal), stacked for matching."""
         index = range(self.viewframe_count)[index]
@@ -331,7 +362,7 @@ class LandmarkTree:
     # ----- learning ---------------------------------------------------------------------------
 
     def add_viewframe(self, tracked: np.ndarray, sightings: LandmarkSet, new: LandmarkSet, *,
-                      share_angle: float = NO_GATE) -> int:
+                      share_angle: float = NO_GATE, place: tuple[float, float] | None = None) -> int:
         """Append a viewframe at the end of the route (algorithm 1, see the module doc); its index.
 
         ``tracked``: map indices of the last viewframe's landmarks seen now, ``sightings`` how
@@ -340,12 +371,15 @@ class LandmarkTree:
         ``share_angle`` (rad) of its stored bearing and it can move up without joining viewframes
         that never saw it; otherwise its sighting is stored in the new leaf. The new leaf's rows
         are appended: map indices from the old ``landmark_count`` on, stored sightings first.
+        ``place``: where odometry put the viewframe; a map has a place for every viewframe or none.
         """
         tracked = np.asarray(tracked, dtype=np.int64).ravel()
         for rows in (sightings, new):
             self._check_rows(rows)
         if len(sightings) != len(tracked) or len(np.unique(tracked)) != len(tracked):
             raise ValueError("tracked landmarks must be distinct, with one sighting each")
+        if (place is None) != (self._places is None) and self._leaves:
+            raise ValueError("a map has a place for every viewframe or for none")
         if not self._leaves:
             if len(tracked):
                 raise ValueError("the first viewframe cannot track landmarks: the map is empty")
@@ -359,6 +393,8 @@ class LandmarkTree:
         self._append_rows(sightings.take(again), leaf)
         self._append_rows(new, leaf)
         self._leaves.append(leaf)
+        if place is not None:
+            self._places = [*(self._places or []), (float(place[0]), float(place[1]))]
         self._cache.clear()
         return len(self._leaves) - 1
 
@@ -467,6 +503,7 @@ class LandmarkTree:
     def _apply(self, cut: LevelCut, levels: int) -> PruneStep:
         before = (self.height, self.memory_bytes(), self.landmark_count)
         self._parent, self._leaves = cut.node_parent, cut.viewframe_leaves
+        self._places = _carried_places(self._places, cut.viewframe_index)
         self._rows = self._rows.take(cut.keep)
         self._rows.node = cut.landmark_nodes
         self._cache.clear()
@@ -488,7 +525,7 @@ class LandmarkTree:
             steps.append(step)
             index, viewframes = follow(index, step.landmark_index), follow(viewframes, step.viewframe_index)
         if steps:
-            self._parent, self._leaves, self._rows = work._parent, work._leaves, work._rows
+            self._parent, self._leaves, self._rows, self._places = work._parent, work._leaves, work._rows, work._places
             self._cache.clear()
         after = self.memory_bytes()
         return PruneReport(budget_bytes, True, before, after, after, tuple(steps), index, viewframes)
@@ -497,6 +534,7 @@ class LandmarkTree:
         """An independent copy (its own arrays and cache)."""
         twin = LandmarkTree(self.kind, threshold=self.threshold, scale=self.scale)
         twin._parent, twin._leaves, twin._rows = list(self._parent), list(self._leaves), self._rows.copy()
+        twin._places = None if self._places is None else list(self._places)
         return twin
 
     # ----- arrays (what a map file holds) -----------------------------------------------------
@@ -505,13 +543,15 @@ class LandmarkTree:
         """The map as plain arrays in canonical order (nodes in preorder, children in route order,
         landmarks grouped by node): ``descriptors`` (N x W) or ``ids`` (N,), ``bearings`` (N x 3
         float32), ``node_parent`` and ``node_size`` (M, int32; the root's parent is -1),
-        ``viewframe_leaf`` (V, int32, route order). Equal maps give equal arrays."""
+        ``viewframe_leaf`` (V, int32, route order) and, when the map has places,
+        ``viewframe_place`` (V x 2 float32). Equal maps give equal arrays."""
         parent = np.array(self._parent, dtype=np.int64)
         order = preorder(parent, np.ones(len(parent), dtype=bool), self._leaves)
         renumber = np.full(len(parent), -1, dtype=np.int64)
         renumber[order] = np.arange(len(order))
         node = renumber[self._rows.node]
         grouped = np.argsort(node, kind="stable")
+        places = {} if self._places is None else {PLACES: np.array(self._places, dtype=PLACE_DTYPE).reshape(-1, 2)}
         return {
             data_name(self.kind): self._rows.data[grouped],
             "bearings": np.ascontiguousarray(self._rows.bearings[grouped], dtype=BEARING_DTYPE),
@@ -519,6 +559,7 @@ class LandmarkTree:
                                     dtype=INDEX_DTYPE).reshape(-1),
             "node_size": np.bincount(node, minlength=len(order)).astype(INDEX_DTYPE),
             "viewframe_leaf": renumber[np.asarray(self._leaves, dtype=np.int64)].astype(INDEX_DTYPE).reshape(-1),
+            **places,
         }
 
     @classmethod
@@ -530,5 +571,7 @@ class LandmarkTree:
         node = np.repeat(np.arange(len(checked.node_parent), dtype=np.int64), checked.node_size)
         tree._parent, tree._leaves = [int(p) for p in checked.node_parent], [int(v) for v in checked.viewframe_leaf]
         tree._rows = _Rows(node, checked.bearings, checked.data)
+        if checked.viewframe_place is not None:
+            tree._places = [(float(x), float(y)) for x, y in checked.viewframe_place]
         return tree
 

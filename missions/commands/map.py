@@ -16,8 +16,11 @@ import os
 import re
 from pathlib import Path
 
+import numpy as np
+
 from maps.ltmap.file import load_ltmap, save_ltmap
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
+from maps.ltmap.tree import LandmarkTree
 from maps.mapfile import read_map_file
 from maps.roadmap import Roadmap
 from maps.store import InputError, output_problem
@@ -96,6 +99,15 @@ def _help(parser: argparse.ArgumentParser) -> int:
     return EXIT_INVALID
 
 
+def _places_text(tree: LandmarkTree) -> str:
+    """Whether the map knows where its viewframes were taught, and the route's length between them."""
+    if not tree.has_places:
+        return "none (followed by vision alone; a map written before version 3 or taught without odometry)"
+    places = np.array([tree.place(i) for i in range(tree.viewframe_count)])
+    length = float(np.linalg.norm(np.diff(places, axis=0), axis=1).sum()) if len(places) > 1 else 0.0
+    return f"taught odometry, {length:.1f} m from the first viewframe to the last"
+
+
 def run_info(args: argparse.Namespace) -> int:
     try:
         kind = read_map_file(args.file).header.kind
@@ -112,7 +124,7 @@ def run_info(args: argparse.Namespace) -> int:
         print(json.dumps({"file": args.file, "landmark_kind": summary.kind, "viewframes": summary.viewframes,
                           "landmarks": summary.landmarks, "nodes": summary.nodes, "height": summary.height,
                           "bytes": summary.memory_bytes, "landmarks_per_level": list(summary.landmarks_per_level),
-                          "threshold": summary.threshold}, indent=2))
+                          "threshold": summary.threshold, "places": tree.has_places}, indent=2))
         return EXIT_OK
     rows = [
         ("landmarks of", summary.kind),
@@ -122,6 +134,7 @@ def run_info(args: argparse.Namespace) -> int:
         ("bytes", f"{summary.memory_bytes} ({summary.memory_bytes / 1024:.1f} KiB)"),
         ("per level", " ".join(str(n) for n in summary.landmarks_per_level) + "  (root first)"),
         ("threshold", f"{summary.threshold:g} (eq. 1: a {change:.1f} deg bearing change)"),
+        ("places", _places_text(tree)),
     ]
     print(args.file)
     for name, value in rows:

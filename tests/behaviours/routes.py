@@ -20,7 +20,8 @@ def taught_map(length: float = 3.0, kind: str = "ids"):
     rng = np.random.default_rng(1)
     learner, places = RouteLearner(LearnConfig()), []
     for pose in straight_route(length, 0.05):
-        if learner.observe(observe_route(WORLD, pose, rng, kind=kind, noise_deg=0.1), pose.theta).created:
+        if learner.observe(observe_route(WORLD, pose, rng, kind=kind, noise_deg=0.1), pose.theta,
+                           (pose.x, pose.y)).created:
             places.append(pose)
     if learner.finish().created:
         places.append(pose)

@@ -234,7 +234,9 @@ def test_follow_route_draws_its_estimate_while_it_follows():
 
 def counted(**counts: int) -> dict:
     rules = ("zinf_1deg", "zinf_2deg", "zinf_4deg", "zinf_8deg", "compass", "no_rotation", "lost")
-    return {"ltmap": {"estimates": {rule: counts.get(rule, 0) for rule in rules}}}
+    return {"ltmap": {"estimates": {rule: counts.get(rule, 0) for rule in rules},
+                      "odometry_drives": 0, "found_by_odometry": 0, "passed_by_odometry": 0,
+                      "odometry_m": 0.0}}
 
 
 def test_follow_route_counts_every_estimate_by_the_rule_that_made_it():

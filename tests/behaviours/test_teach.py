@@ -58,6 +58,11 @@ def test_learn_route_saves_the_map_when_the_drive_succeeds(tmp_path):
                              "gap_filling", "shifted", "loops", "loop_closures"]
     assert section["map_file"] == str(path) and section["online_prunes"] == 0
     assert section["gap_filling"] is True and section["loops"] == [] and section["loop_closures"] == 0
+    # each viewframe keeps the odometry place it was taught at (the pose of the tick at its taught time)
+    at = [poses[round(entry["time_s"] / 0.1)] for entry in section["taught"]]
+    assert saved.has_places and len(at) == saved.viewframe_count
+    for index, pose in enumerate(at):
+        assert saved.place(index) == pytest.approx([pose.x, pose.y], abs=1e-6)
     times = [entry["time_s"] for entry in section["taught"]]
     assert len(times) == saved.viewframe_count and times == sorted(times) and times[-1] == pytest.approx(6.0)
 
@@ -117,5 +122,7 @@ def test_learn_route_reports_nothing_before_its_first_observation_and_draws_new_
     teach(harness, poses[:6])
     (drawn,) = node.drawings()
     assert isinstance(drawn, Points) and drawn.entity == "odometry_frame/route/viewframes"
-    assert drawn.positions.tolist() == node.places and drawn.colours == (255, 200, 0) and drawn.radius == 0.05
+    tree = harness.read("/map/ltmap")
+    assert drawn.positions.tolist() == [tree.place(i).tolist() for i in range(tree.viewframe_count)]
+    assert drawn.colours == (255, 200, 0) and drawn.radius == 0.05
     assert list(node.drawings()) == []  # no new viewframe: nothing drawn

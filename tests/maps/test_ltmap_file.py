@@ -12,10 +12,11 @@ from maps.store import InputError
 from perception.synthetic_route import make_route_world, observe_route, straight_route
 
 
-def taught(kind: str, length: float = 2.0):
+def taught(kind: str, length: float = 2.0, places: bool = True):
     world, rng, learner = make_route_world(3, length=length, n_near=300), np.random.default_rng(4), RouteLearner()
     for pose in straight_route(length, 0.05):
-        learner.observe(observe_route(world, pose, rng, kind=kind, noise_deg=0.1), pose.theta)
+        place = (pose.x, pose.y) if places else None
+        learner.observe(observe_route(world, pose, rng, kind=kind, noise_deg=0.1), pose.theta, place)
     learner.finish()
     return learner.tree
 
@@ -32,6 +33,7 @@ def test_a_saved_map_loads_identical(tmp_path, kind):
         assert np.array_equal(again[name], array) and again[name].dtype == array.dtype
     assert (loaded.kind, loaded.threshold, loaded.scale) == (tree.kind, tree.threshold, tree.scale)
     assert loaded.summary() == tree.summary()
+    assert loaded.has_places and loaded.place(-1).tolist() == pytest.approx([2.0, 0.0])  # the goal's, taught last
     for i in range(tree.viewframe_count):  # the same viewframes, landmark for landmark
         a, b = tree.viewframe(i), loaded.viewframe(i)
         data_a = a.ids if kind == "ids" else a.descriptors
@@ -59,7 +61,7 @@ def test_every_bad_file_is_one_clear_line():
     assert "checksum" in one_line_error(bytes(flipped))
     assert "not a bearings map" in one_line_error(b"\x89PNG\r\n\x1a\n")
     assert "roadmap map file, not a ltmap" in one_line_error(encode_map(kind="roadmap", version=1, arrays={}))
-    assert "version 3" in one_line_error(encode_map(kind=KIND, version=3, arrays={}))
+    assert "version 4" in one_line_error(encode_map(kind=KIND, version=4, arrays={}))
 
 
 def test_a_version_1_map_is_read_with_the_eq1_threshold_of_the_same_bearing_change():
@@ -71,6 +73,15 @@ def test_a_version_1_map_is_read_with_the_eq1_threshold_of_the_same_bearing_chan
     loaded = decode_ltmap(old, file="old.ltmap")
     assert loaded.threshold == pytest.approx(1.129182e-6, rel=1e-4)
     assert loaded.scale == tree.scale and loaded.viewframe_count == tree.viewframe_count
+
+
+def test_a_version_2_map_has_no_places_and_follows_as_before():
+    tree = taught("ids", 1.0, places=False)
+    assert "viewframe_place" not in tree.to_arrays()
+    old = encode_map(kind=KIND, version=2, arrays=tree.to_arrays(),
+                     meta={"landmarks": "ids", "threshold": tree.threshold})
+    loaded = decode_ltmap(old, file="old.ltmap")
+    assert not loaded.has_places and loaded.place(0) is None and loaded.viewframe_count == tree.viewframe_count
 
 
 def test_a_sound_container_with_an_inconsistent_tree_is_refused():
@@ -87,6 +98,10 @@ def test_a_sound_container_with_an_inconsistent_tree_is_refused():
     assert "int64" in broken(ids=arrays["ids"].astype(np.float64))
     assert "meta" in one_line_error(encode_map(kind=KIND, version=1, arrays=arrays, meta={"landmarks": "surf"}))
     assert "unexpected" in broken(extra=np.zeros(3))
+    views = len(arrays["viewframe_leaf"])
+    assert "viewframe_place" in broken(viewframe_place=np.zeros((views - 1, 2), dtype=np.float32))
+    assert "viewframe_place" in broken(viewframe_place=np.full((views, 2), np.nan, dtype=np.float32))
+    assert "viewframe_place" in broken(viewframe_place=np.zeros((views, 2)))  # float64
 
 
 def test_a_failed_save_keeps_the_previous_map(tmp_path, monkeypatch):

@@ -141,3 +141,36 @@ def test_levels_cut_at_once_give_what_cutting_them_one_by_one_gives(seed):
         assert report.levels_cut == cuts and report.bytes_after == one_by_one.memory_bytes()
         assert same_arrays(tree.to_arrays(), one_by_one.to_arrays())
         assert np.array_equal(report.landmark_index, index) and np.array_equal(report.viewframe_index, views)
+
+
+def test_a_cut_keeps_the_place_of_the_earliest_viewframe_merged_into_each_kept_one():
+    from maps.ltmap.tree import _carried_places
+
+    places = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.5), (3.0, 1.0)]
+    # the first test's cut: viewframe 1 deleted, 2 and 3 merged into new viewframe 1 (the earlier, 2)
+    assert _carried_places(places, np.array([0, -1, 1, 1])) == [(0.0, 0.0), (2.0, 0.5)]
+    assert _carried_places(None, np.array([0, 0])) is None
+
+
+def test_pruning_to_a_budget_carries_each_kept_viewframes_place_and_the_file_arrays_hold_them():
+    rows, tree = Rows(np.random.default_rng(7)), LandmarkTree(IDS)
+    for view in range(6):
+        last = tree.viewframe(-1).landmarks if tree.viewframe_count else np.zeros(0, dtype=np.int64)
+        tracked = last[: len(last) // 2]
+        tree.add_viewframe(tracked, rows.make(tree.bearings[tracked]), rows.random(20), place=(0.5 * view, 0.0))
+    before = tree.memory_bytes()
+    assert before == sum(a.nbytes for a in tree.to_arrays().values())  # 8 bytes a place, counted as map content
+    report = tree.prune_to(before // 2, min_landmarks=0)
+    assert report.fits and tree.has_places
+    kept = [min(np.flatnonzero(report.viewframe_index == new)) for new in range(tree.viewframe_count)]
+    assert [tree.place(i).tolist() for i in range(tree.viewframe_count)] == [[0.5 * old, 0.0] for old in kept]
+    assert tree.to_arrays()["viewframe_place"].shape == (tree.viewframe_count, 2)
+    assert LandmarkTree.from_arrays(tree.to_arrays(), kind=IDS).place(-1).tolist() == tree.place(-1).tolist()
+
+
+def test_a_map_has_a_place_for_every_viewframe_or_for_none():
+    rows, tree = Rows(np.random.default_rng(7)), LandmarkTree(IDS)
+    tree.add_viewframe(np.zeros(0, dtype=np.int64), rows.make(np.zeros((0, 3))), rows.random(5))
+    assert not tree.has_places and tree.place(0) is None and "viewframe_place" not in tree.to_arrays()
+    with np.testing.assert_raises(ValueError):
+        tree.add_viewframe(np.zeros(0, dtype=np.int64), rows.make(np.zeros((0, 3))), rows.random(5), place=(1.0, 0.0))

@@ -18,7 +18,7 @@ from perception.synthetic_route import make_route_world, observe_route, straight
 def route_file(tmp_path_factory):
     world, rng, learner = make_route_world(5, length=4.0, n_near=400), np.random.default_rng(6), RouteLearner()
     for pose in straight_route(4.0, 0.05):
-        learner.observe(observe_route(world, pose, rng, noise_deg=0.1), pose.theta)
+        learner.observe(observe_route(world, pose, rng, noise_deg=0.1), pose.theta, (pose.x, pose.y))
     learner.finish()
     path = tmp_path_factory.mktemp("maps") / "route.ltmap"
     save_ltmap(path, learner.tree)
@@ -33,6 +33,20 @@ def test_info_prints_the_tree(route_file, capsys):
                         ("height", summary.height), ("bytes", summary.memory_bytes)):
         assert f"{name:<13}{value}" in text
     assert " ".join(map(str, summary.landmarks_per_level)) in text
+    # the first viewframe is made at the second image (0.05 m), the goal at 4 m: 3.95 m along x
+    assert "places       taught odometry, 3.9 m from the first viewframe to the last" in text
+
+
+def test_info_says_when_a_map_has_no_places(tmp_path, capsys):
+    world, rng, learner = make_route_world(5, length=1.0, n_near=400), np.random.default_rng(6), RouteLearner()
+    for pose in straight_route(1.0, 0.05):
+        learner.observe(observe_route(world, pose, rng, noise_deg=0.1), pose.theta)
+    learner.finish()
+    save_ltmap(tmp_path / "old.ltmap", learner.tree)
+    assert main(["map", "info", str(tmp_path / "old.ltmap")]) == 0
+    assert "places       none (followed by vision alone" in capsys.readouterr().out
+    assert main(["map", "info", str(tmp_path / "old.ltmap"), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["places"] is False
 
 
 def test_info_json(route_file, capsys):
@@ -41,6 +55,7 @@ def test_info_json(route_file, capsys):
     summary = load_ltmap(route_file).summary()
     assert figures["bytes"] == summary.memory_bytes and figures["height"] == summary.height
     assert sum(figures["landmarks_per_level"]) == figures["landmarks"] == summary.landmarks
+    assert figures["places"] is True
 
 
 def test_prune_writes_a_map_within_the_budget(route_file, tmp_path, capsys):
