@@ -25,7 +25,7 @@ Otherwise its status is the child's. While it holds the robot for the way to cle
 partly hidden by the obstacle in front, and that the avoidance is about to act (``FollowRoute``
 does not count losing the trail then, and leaves the avoidance its wait). The algorithm is
 :mod:`maps.avoidance` (pure); the echoes of the last ``memory`` seconds are judged together
-(:mod:`maps.avoidance.memory`). Without range sensors (no ``/robot/ranges``) it sees nothing and
+(:mod:`perception.obstacle_memory`). Without range sensors (no ``/robot/ranges``) it sees nothing and
 passes every command on; the collision monitor still limits whatever reaches the base.
 ``enabled: false`` passes every command on, for runs that compare with and without it.
 
@@ -59,10 +59,10 @@ from drivers.interfaces import STOP, VelocityCommand
 from maps.avoidance.backoff import BackoffSettings
 from maps.avoidance.detour import Avoidance, Decision, DetourSettings, Phase
 from maps.avoidance.directions import Choice
-from maps.avoidance.memory import ObstacleMemory
 from maps.avoidance.sweep import AvoidSettings
 from perception.collision_monitor import SafetyState
 from perception.geometry import Pose2D
+from perception.obstacle_memory import ObstacleMemory
 from perception.polygons import disc
 from perception.ranges import RangeScan
 

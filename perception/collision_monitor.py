@@ -18,6 +18,16 @@ restrictive action of all wins. Here:
 - **no data** (no scan, a scan older than ``source_timeout``, every sensor silent): the command is
   limited to a crawl (``crawl_speed``, ``crawl_turn_rate``) and the state says why.
 
+The points judged are the scan's and, given by the caller, the echoes of the last ``memory``
+seconds where odometry put them (:mod:`perception.obstacle_memory`; the guarded base keeps them;
+off by default: measured, it costs the roadmap's learning and the repeats among people, docs/obstacles.md).
+A sonar ring has blind gaps beside the robot (between its 50 and 90 degree cones) and places an
+echo on its cone's axis: a desk corner the robot passes slips out of the front cones into the gap
+and, judged on the current scan alone, no longer lies on the sweep; the lab's roadmap learning
+drove into one twice (docs/failure.md). ARIA keeps such a cumulative buffer besides the current
+readings for the same reason (``ArRangeDevice``'s cumulative readings, ``ArRobot::
+checkRangeDevicesCumulativeBox``).
+
 Every action is a ratio in [0, 1] applied to ``v`` and ``w`` alike, so the command keeps its arc,
 is never amplified and never reversed. Zones act only on points the command's sweep reaches
 (unlike Nav2's fixed polygons, which stop every motion while a point is inside): backing away
@@ -64,6 +74,7 @@ class MonitorConfig:
     source_timeout: float = 1.0  # s: an older scan is no data
     crawl_speed: float = 0.1  # m/s without data
     crawl_turn_rate: float = math.radians(20.0)  # rad/s without data
+    memory: float = 0.0  # s: echoes this recent are judged with the scan (the guarded base keeps them); 0: none
 
 
 @dataclass(frozen=True, slots=True)
@@ -113,11 +124,15 @@ class CollisionMonitor:
     def __init__(self, config: MonitorConfig) -> None:
         self.config = config
 
-    def check(self, v: float, w: float, scan: RangeScan | None, now: float) -> Verdict:
-        """The command ``(v, w)`` limited against ``scan`` at time ``now`` (the scan's clock)."""
+    def check(self, v: float, w: float, scan: RangeScan | None, now: float,
+              remembered: np.ndarray | None = None) -> Verdict:
+        """The command ``(v, w)`` limited against ``scan`` at time ``now`` (the scan's clock) and
+        the ``remembered`` echoes of earlier scans (base frame, N x 2), judged alike while the scan is fresh."""
         bumped = scan is not None and bool(np.any(scan.pressed))
         fresh = self._data_problem(scan, now)
         points = scan.points() if fresh is None and scan is not None else np.zeros((0, 2))
+        if fresh is None and remembered is not None and len(remembered):
+            points = np.vstack((points, np.asarray(remembered, dtype=float).reshape(-1, 2)))
         gaps = distance(self.config.footprint, points)
         nearest = float(gaps.min()) if len(points) else math.inf
         limits: list[_Limit] = []

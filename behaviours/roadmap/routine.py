@@ -31,9 +31,9 @@ from behaviours.keys import RANGES_KEY
 from behaviours.motion import COMMAND, ODOMETRY, STALLED, Drive, DriveTo, Rotate
 from behaviours.ports import InputPort, OutputPort, Port, Ref
 from drivers.interfaces import STOP, PanTiltCommand, PanTiltState
-from maps.avoidance.memory import ObstacleMemory
 from perception.frame import Frame
 from perception.geometry import Pose2D, wrap_angle
+from perception.obstacle_memory import ObstacleMemory
 from perception.ranges import RangeScan
 
 T = TypeVar("T")

@@ -3,7 +3,9 @@
 The runner wraps the robot's base in it before the tree is set up (``missions/runner.py``), on
 the robot and in the simulator alike, whatever the mission: every ``drive(v, w)`` reads the
 newest scan of the robot's :class:`~drivers.interfaces.RangeSource`, asks
-:class:`~perception.collision_monitor.CollisionMonitor` for the limited command, records the
+:class:`~perception.collision_monitor.CollisionMonitor` for the limited command against it and
+the echoes of the last ``memory`` seconds (kept where the base's odometry put them,
+:class:`~perception.obstacle_memory.ObstacleMemory`), records the
 verdict (:class:`~drivers.safety.log.SafetyLog`) and sends the limited command to the base.
 ``stop()`` goes straight through (stopping is always allowed), as do ``odometry()``,
 ``stalled()``, ``close()`` and anything else the wrapped driver offers (``status()``,
@@ -18,10 +20,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 from drivers.interfaces import Base, RangeSource
 from drivers.safety.log import SafetyLog
 from perception.collision_monitor import CollisionMonitor, SafetyState, Verdict
 from perception.geometry import Pose2D
+from perception.obstacle_memory import ObstacleMemory
 from perception.ranges import RangeScan
 
 
@@ -36,6 +41,7 @@ class GuardedBase:
         self.clock = clock
         self.state = SafetyState(reason="no command yet")
         self.scan: RangeScan | None = None
+        self.memory = ObstacleMemory(keep=monitor.config.memory)
         self.log = SafetyLog(sources=_describe(ranges))
 
     def drive(self, v: float, w: float) -> None:
@@ -45,10 +51,21 @@ class GuardedBase:
             verdict = Verdict(v, w, SafetyState(reason="no range sensors", stamp=now))
         else:
             self.scan = self.ranges.read()
-            verdict = self.monitor.check(v, w, self.scan, now)
+            verdict = self.monitor.check(v, w, self.scan, now, self._remembered(self.scan, now))
         self.state = verdict.state
         self.log.add(v, w, verdict)
         self.base.drive(verdict.v, verdict.w)
+
+    def _remembered(self, scan: RangeScan | None, now: float) -> np.ndarray | None:
+        """The echoes of earlier scans (within ``memory`` seconds) in the base frame now; the new
+        scan joins them for the next command. They are kept for their time whatever newer scans
+        say: dropping those a transducer no longer hears was measured and not kept (docs/failure.md)."""
+        if scan is None or self.memory.keep <= 0.0:
+            return None
+        pose = self.base.odometry()
+        earlier = self.memory.around(pose, now)
+        self.memory = self.memory.added(scan.points(), pose, scan.stamp)
+        return earlier
 
     def stop(self) -> None:
         self.base.stop()

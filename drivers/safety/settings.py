@@ -50,6 +50,9 @@ class SafetySettings(BaseModel):
                                      ge=0.05, le=10.0)
     crawl_speed: float = quantity(0.1, "speed limit while there is no range data", "m/s", ge=0.0, le=0.5)
     crawl_turn_rate: float = quantity(20.0, "turn rate limit while there is no range data", "deg/s", ge=0.0, le=90.0)
+    memory: float = quantity(0.0, "echoes this recent are judged with the newest scan, where odometry put them (a "
+                             "sonar ring's blind gaps beside the robot; e.g. 1); 0: the newest scan alone", "s",
+                             ge=0.0, le=10.0)
 
     @field_validator("footprint", "stop_zone", "slowdown_zone")
     @classmethod
@@ -83,4 +86,4 @@ def monitor_config(settings: SafetySettings | None, footprint: np.ndarray) -> Mo
             raise ValueError(f"safety: the {name}_zone must contain the whole footprint")
         zones.append(Zone(name, polygon, action, ratio))  # type: ignore[arg-type]
     return MonitorConfig(body, tuple(zones), settings.time_before_collision, settings.source_timeout,
-                         settings.crawl_speed, math.radians(settings.crawl_turn_rate))
+                         settings.crawl_speed, math.radians(settings.crawl_turn_rate), memory=settings.memory)

@@ -7,13 +7,14 @@ module          what it holds
                 touches a point; how far a motion node means to go (is its arc free?)
 ``directions``  the free direction closest to the wish (a polar histogram, VFH+) and the
                 command that takes it (an arc, or a turn on the spot first)
-``memory``      obstacle points of the last second, kept in the odometry frame
 ``backoff``     backing away along the robot's own trail when no direction will do
 ``detour``      one tick's decision: pass the wish on, wait for the way to clear, detour,
                 back away, or give up; the tallies the report gets (detours, length,
                 time, waits, back-offs)
 ==============  =========================================================================
 
-Everything is in the base frame (REP-103: x forward, y left) unless a name says odometry.
+Everything is in the base frame (REP-103: x forward, y left) unless a name says odometry. The
+obstacle points of the last second, kept in the odometry frame, are :mod:`perception.obstacle_memory`
+(the collision monitor remembers them too).
 docs/obstacles.md is the overview.
 """

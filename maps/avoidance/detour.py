@@ -1,7 +1,7 @@
 """One tick of getting around what blocks the way: pass the wish on, wait, detour, or give up.
 
 A motion node wishes a command ``(v, w)``; :class:`Avoidance` decides, once per tick, what the
-base gets instead, from the obstacle points around the base (:mod:`maps.avoidance.memory`) and
+base gets instead, from the obstacle points around the base (:mod:`perception.obstacle_memory`) and
 the robot's odometry. Three phases:
 
 - **clear**: the wish passes unchanged. A forward wish whose arc is not free for as far as it

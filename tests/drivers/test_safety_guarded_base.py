@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from drivers.fake import FakeBase
 from drivers.pioneer_body import BODIES
 from drivers.safety.guarded_base import GuardedBase
-from drivers.safety.settings import monitor_config
+from drivers.safety.settings import SafetySettings, monitor_config
 from perception.collision_monitor import CollisionMonitor
+from perception.geometry import Pose2D
 from perception.ranges import RangeScan, RangeSensor
 
 
@@ -64,3 +67,51 @@ def test_stop_and_the_drivers_extras_go_straight_through():
     assert guard.closed is False  # FakeBase's own attribute, read through the guard
     guard.close()
     assert base.closed
+
+
+class Clock:
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+FRONT = RangeSensor(0.2, 0.0, 0.0)  # a transducer at the front, looking ahead
+REAR = RangeSensor(-0.2, 0.0, math.pi)  # one looking back, hearing nothing
+
+
+def ring(front: float, stamp: float) -> RangeScan:
+    return RangeScan((FRONT, REAR), np.array([front, np.inf]), stamp)
+
+
+def remembering(memory: float) -> tuple[GuardedBase, FakeBase, Ranges, Clock]:
+    base, ranges, clock = FakeBase(), Ranges(None), Clock()
+    monitor = CollisionMonitor(monitor_config(SafetySettings(memory=memory), BODIES["p3dx"].footprint))
+    return GuardedBase(base, monitor, ranges, clock), base, ranges, clock
+
+
+def test_an_echo_of_the_last_second_stops_the_robot_where_odometry_puts_it_though_the_new_scan_misses_it():
+    for memory, expected in ((1.0, (0.0, 0.0)), (0.0, (0.3, 0.0))):
+        guard, base, ranges, clock = remembering(memory)
+        # t = 0: an echo 0.4 m ahead of the transducer, 0.6 m ahead of the centre: 0.39 m past the front
+        # (P3-DX: 0.210 m), outside the stop zone (0.10 m) and 1.3 s away at 0.3 m/s: passes
+        ranges.scan = ring(0.4, 0.0)
+        guard.drive(0.3, 0.0)
+        assert base.commands[-1] == (0.3, 0.0)
+        # t = 0.5 s: 0.3 m on by odometry, the echo missed: remembered, it lies 0.09 m past the front,
+        # in the stop zone
+        clock.now, base.pose = 0.5, Pose2D(0.3, 0.0, 0.0)
+        ranges.scan = ring(np.inf, 0.5)
+        guard.drive(0.3, 0.0)
+        assert base.commands[-1] == expected  # memory 0: the newest scan alone, nothing there
+
+
+def test_an_echo_older_than_the_memory_is_forgotten():
+    guard, base, ranges, clock = remembering(1.0)
+    ranges.scan = ring(0.4, 0.0)
+    guard.drive(0.0, 0.0)
+    clock.now, base.pose = 1.5, Pose2D(0.3, 0.0, 0.0)
+    ranges.scan = ring(np.inf, 1.5)
+    guard.drive(0.3, 0.0)
+    assert base.commands[-1] == (0.3, 0.0)

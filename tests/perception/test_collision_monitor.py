@@ -136,3 +136,14 @@ def test_never_amplified_never_reversed_and_the_arc_is_kept(ranges, v, w, age, p
 def test_backing_straight_away_from_anything_ahead_is_never_limited(points, v):
     verdict = check(v, 0.0, scan_of(*points))
     assert (verdict.v, verdict.w, verdict.state.state) == (v, 0.0, "clear")
+
+
+def test_remembered_echoes_are_judged_like_the_scans_own_while_the_scan_is_fresh():
+    silent = scan_of()
+    monitor = CollisionMonitor(CONFIG)
+    remembered = np.array([[0.28, 0.0]])  # 0.07 m in front of the footprint, seen a moment ago
+    verdict = monitor.check(0.2, 0.0, silent, 0.0, remembered)
+    assert (verdict.v, verdict.state.action) == (0.0, "stop") and verdict.state.nearest_m == pytest.approx(0.07)
+    assert monitor.check(0.2, 0.0, silent, 0.0).v == 0.2  # the scan alone: nothing
+    stale = monitor.check(0.2, 0.0, silent, 5.0, remembered)  # no fresh data: the crawl decides, not old echoes
+    assert stale.state.action == "crawl" and stale.v == pytest.approx(0.1)

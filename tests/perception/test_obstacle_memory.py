@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from maps.avoidance.memory import ObstacleMemory
 from perception.geometry import Pose2D, frame_to_parent, parent_to_frame
+from perception.obstacle_memory import ObstacleMemory
 
 
 def test_points_go_to_the_odometry_frame_and_back():
