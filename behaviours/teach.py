@@ -35,7 +35,7 @@ from behaviours.ports import WRITES, InputPort, Ref
 from behaviours.registry import register
 from behaviours.telemetry import Drawing, Figure, Points, section
 from maps.ltmap.learner import LearnConfig, LearnStep, RouteLearner
-from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
+from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS, earliest_sources
 from maps.ltmap.tree import DEFAULT_THRESHOLD
 from maps.store import InputError
 from perception.observation import Observation
@@ -114,11 +114,8 @@ class LearnRoute(BearingsDecorator):
             self._looping = step.loop is not None
         if step.pruned is not None and step.pruned.fits:
             self.prunes += 1
-            kept: dict[int, int] = {}  # new viewframe -> the earliest old one it came from
-            for old, new in enumerate(step.pruned.viewframe_index[:-1].tolist()):  # the last is the new one
-                if new >= 0:
-                    kept.setdefault(new, old)
-            self.taught = [self.taught[kept[k]] for k in sorted(kept)]
+            kept = earliest_sources(step.pruned.viewframe_index[:-1])  # the last is the new one
+            self.taught = [self.taught[old] for old in kept]
         if step.created:
             self.taught.append(round(self.now(), 3))
         tree = self.learner.tree

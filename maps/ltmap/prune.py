@@ -110,6 +110,17 @@ def cut_lowest_level(node_parent: Sequence[int], viewframe_leaves: Sequence[int]
     return _restructure(parent, node, keep, ends, viewframes, merged + identical, len(weak))
 
 
+def earliest_sources(viewframe_index: np.ndarray) -> list[int]:
+    """For each viewframe after a prune (in order), the earliest old viewframe merged into it
+    (``viewframe_index``: each old viewframe's new index, -1 when deleted): what it keeps of the
+    old ones' own records (the time and the place it was taught)."""
+    kept: dict[int, int] = {}
+    for old, new in enumerate(np.asarray(viewframe_index).tolist()):
+        if new >= 0:
+            kept.setdefault(new, old)
+    return [kept[k] for k in sorted(kept)]
+
+
 def follow(index: np.ndarray, step_index: np.ndarray) -> np.ndarray:
     """Indices (-1: gone) carried through one more prune step whose ``step_index`` maps old to new."""
     return np.where(index >= 0, step_index[np.maximum(index, 0)], -1)

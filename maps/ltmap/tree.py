@@ -81,6 +81,7 @@ from maps.ltmap.prune import (
     PruneStep,
     cut_lowest_level,
     cut_quiet_levels,
+    earliest_sources,
     follow,
     quiet_levels,
 )
@@ -181,13 +182,7 @@ def _carried_places(places: list[tuple[float, float]] | None, viewframe_index: n
                     ) -> list[tuple[float, float]] | None:
     """The places after a cut: a kept viewframe keeps the place of the earliest viewframe merged
     into it (``viewframe_index``: each old viewframe's new index, -1 when deleted)."""
-    if places is None:
-        return None
-    kept: dict[int, tuple[float, float]] = {}
-    for old, new in enumerate(np.asarray(viewframe_index).tolist()):
-        if new >= 0:
-            kept.setdefault(new, places[old])
-    return [kept[k] for k in sorted(kept)]
+    return None if places is None else [places[old] for old in earliest_sources(viewframe_index)]
 
 
 @dataclass

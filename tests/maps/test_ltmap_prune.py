@@ -7,7 +7,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from maps.ltmap.arrays import IDS
-from maps.ltmap.prune import cut_lowest_level, follow
+from maps.ltmap.prune import cut_lowest_level, earliest_sources, follow
 from maps.ltmap.tree import LandmarkTree
 from tests.maps.ltmap_trees import Rows, same_arrays
 
@@ -143,13 +143,10 @@ def test_levels_cut_at_once_give_what_cutting_them_one_by_one_gives(seed):
         assert np.array_equal(report.landmark_index, index) and np.array_equal(report.viewframe_index, views)
 
 
-def test_a_cut_keeps_the_place_of_the_earliest_viewframe_merged_into_each_kept_one():
-    from maps.ltmap.tree import _carried_places
-
-    places = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.5), (3.0, 1.0)]
+def test_each_kept_viewframe_comes_from_the_earliest_one_merged_into_it():
     # the first test's cut: viewframe 1 deleted, 2 and 3 merged into new viewframe 1 (the earlier, 2)
-    assert _carried_places(places, np.array([0, -1, 1, 1])) == [(0.0, 0.0), (2.0, 0.5)]
-    assert _carried_places(None, np.array([0, 0])) is None
+    assert earliest_sources(np.array([0, -1, 1, 1])) == [0, 2]
+    assert earliest_sources(np.array([0, 0])) == [0] and earliest_sources(np.array([-1, 0, 1])) == [1, 2]
 
 
 def test_pruning_to_a_budget_carries_each_kept_viewframes_place_and_the_file_arrays_hold_them():
