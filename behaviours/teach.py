@@ -116,6 +116,7 @@ class LearnRoute(BearingsDecorator):
             self.prunes += 1
             kept = earliest_sources(step.pruned.viewframe_index[:-1])  # the last is the new one
             self.taught = [self.taught[old] for old in kept]
+            self._logged = -1  # the places drawn changed, whatever their count
         if step.created:
             self.taught.append(round(self.now(), 3))
         tree = self.learner.tree
