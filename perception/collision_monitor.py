@@ -19,8 +19,8 @@ restrictive action of all wins. Here:
   limited to a crawl (``crawl_speed``, ``crawl_turn_rate``) and the state says why.
 
 The points judged are the scan's and, given by the caller, the echoes of the last ``memory``
-seconds where odometry put them (:mod:`perception.obstacle_memory`; the guarded base keeps them;
-off by default: measured, it costs the roadmap's learning and the repeats among people, docs/obstacles.md).
+seconds where odometry put them (:mod:`perception.obstacle_memory`; the guarded base keeps them,
+and passes on only those in the ring's blind gaps: where a transducer looks now, its reading rules).
 A sonar ring has blind gaps beside the robot (between its 50 and 90 degree cones) and places an
 echo on its cone's axis: a desk corner the robot passes slips out of the front cones into the gap
 and, judged on the current scan alone, no longer lies on the sweep; the lab's roadmap learning
@@ -74,7 +74,7 @@ class MonitorConfig:
     source_timeout: float = 1.0  # s: an older scan is no data
     crawl_speed: float = 0.1  # m/s without data
     crawl_turn_rate: float = math.radians(20.0)  # rad/s without data
-    memory: float = 0.0  # s: echoes this recent are judged with the scan (the guarded base keeps them); 0: none
+    memory: float = 1.0  # s: echoes this recent are judged with the scan (the guarded base keeps them); 0: none
 
 
 @dataclass(frozen=True, slots=True)

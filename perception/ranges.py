@@ -70,6 +70,20 @@ class RangeScan:
         echoes = np.column_stack((x[echo] + r * np.cos(heading[echo]), y[echo] + r * np.sin(heading[echo])))
         return np.vstack((echoes, np.asarray(self.extra, dtype=float).reshape(-1, 2)))
 
+    def covers(self, points: np.ndarray) -> np.ndarray:
+        """Which ``points`` (base frame, N x 2) lie inside the cone of a sensor that has a reading
+        (within its ``max_range``): where this scan's own readings say what is there. The rest lie
+        in the ring's blind gaps (or beyond its reach)."""
+        points = np.asarray(points, dtype=float).reshape(-1, 2)
+        covered = np.zeros(len(points), dtype=bool)
+        for sensor, reading in zip(self.sensors, np.asarray(self.ranges, dtype=float), strict=True):
+            if np.isnan(reading):
+                continue
+            dx, dy = points[:, 0] - sensor.x, points[:, 1] - sensor.y
+            off = np.abs(np.angle(np.exp(1j * (np.arctan2(dy, dx) - sensor.heading))))
+            covered |= (off <= sensor.fov / 2.0) & (np.hypot(dx, dy) <= sensor.max_range)
+        return covered
+
     def bumped(self, facing: int) -> bool:
         """Is any bumper facing ``facing`` (+1 front, -1 rear) pressed?"""
         return any(p and b.facing == facing for b, p in zip(self.bumpers, self.pressed, strict=True))

@@ -58,14 +58,14 @@ class GuardedBase:
 
     def _remembered(self, scan: RangeScan | None, now: float) -> np.ndarray | None:
         """The echoes of earlier scans (within ``memory`` seconds) in the base frame now; the new
-        scan joins them for the next command. They are kept for their time whatever newer scans
-        say: dropping those a transducer no longer hears was measured and not kept (docs/failure.md)."""
+        scan joins them for the next command. Only those in the ring's blind gaps count: where a
+        transducer looks now, its own reading says what is there (``RangeScan.covers``)."""
         if scan is None or self.memory.keep <= 0.0:
             return None
         pose = self.base.odometry()
         earlier = self.memory.around(pose, now)
         self.memory = self.memory.added(scan.points(), pose, scan.stamp)
-        return earlier
+        return earlier[~scan.covers(earlier)]
 
     def stop(self) -> None:
         self.base.stop()

@@ -50,8 +50,8 @@ class SafetySettings(BaseModel):
                                      ge=0.05, le=10.0)
     crawl_speed: float = quantity(0.1, "speed limit while there is no range data", "m/s", ge=0.0, le=0.5)
     crawl_turn_rate: float = quantity(20.0, "turn rate limit while there is no range data", "deg/s", ge=0.0, le=90.0)
-    memory: float = quantity(0.0, "echoes this recent are judged with the newest scan, where odometry put them (a "
-                             "sonar ring's blind gaps beside the robot; e.g. 1); 0: the newest scan alone", "s",
+    memory: float = quantity(1.0, "echoes this recent, in the sonar ring's blind gaps now, are judged with the "
+                             "newest scan where odometry put them; 0: the newest scan alone", "s",
                              ge=0.0, le=10.0)
 
     @field_validator("footprint", "stop_zone", "slowdown_zone")

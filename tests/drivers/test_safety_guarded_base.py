@@ -91,27 +91,39 @@ def remembering(memory: float) -> tuple[GuardedBase, FakeBase, Ranges, Clock]:
     return GuardedBase(base, monitor, ranges, clock), base, ranges, clock
 
 
-def test_an_echo_of_the_last_second_stops_the_robot_where_odometry_puts_it_though_the_new_scan_misses_it():
-    for memory, expected in ((1.0, (0.0, 0.0)), (0.0, (0.3, 0.0))):
+def test_an_echo_turned_into_the_blind_gap_beside_the_robot_still_stops_an_arc_into_it():
+    for memory, expected in ((1.0, (0.0, 0.0)), (0.0, (0.2, -0.8))):
         guard, base, ranges, clock = remembering(memory)
-        # t = 0: an echo 0.4 m ahead of the transducer, 0.6 m ahead of the centre: 0.39 m past the front
-        # (P3-DX: 0.210 m), outside the stop zone (0.10 m) and 1.3 s away at 0.3 m/s: passes
-        ranges.scan = ring(0.4, 0.0)
-        guard.drive(0.3, 0.0)
-        assert base.commands[-1] == (0.3, 0.0)
-        # t = 0.5 s: 0.3 m on by odometry, the echo missed: remembered, it lies 0.09 m past the front,
-        # in the stop zone
-        clock.now, base.pose = 0.5, Pose2D(0.3, 0.0, 0.0)
+        # t = 0: an echo 0.1 m ahead of the front transducer, at (0.3, 0) (odometry = base frame)
+        ranges.scan = ring(0.1, 0.0)
+        guard.drive(0.0, 0.0)
+        # t = 0.5 s: turned +60 deg on the spot; the echo now lies at (0.15, -0.26), 90 deg right of
+        # the front transducer, outside every cone, 0.047 m beside the P3-DX's box (half-width
+        # 0.2125 m): in the stop zone, and an arc to the right (0.25 m radius) runs the front right
+        # corner into it
+        clock.now, base.pose = 0.5, Pose2D(0.0, 0.0, math.radians(60.0))
         ranges.scan = ring(np.inf, 0.5)
-        guard.drive(0.3, 0.0)
+        guard.drive(0.2, -0.8)
         assert base.commands[-1] == expected  # memory 0: the newest scan alone, nothing there
+
+
+def test_where_a_transducer_looks_now_its_reading_rules_not_the_memory():
+    guard, base, ranges, clock = remembering(1.0)
+    # t = 0: an echo 0.6 m ahead of the centre; t = 0.5 s, 0.3 m on: the front transducer looks
+    # there and hears nothing (someone walked on), so the remembered echo does not count
+    ranges.scan = ring(0.4, 0.0)
+    guard.drive(0.3, 0.0)
+    clock.now, base.pose = 0.5, Pose2D(0.3, 0.0, 0.0)
+    ranges.scan = ring(np.inf, 0.5)
+    guard.drive(0.3, 0.0)
+    assert base.commands[-1] == (0.3, 0.0)
 
 
 def test_an_echo_older_than_the_memory_is_forgotten():
     guard, base, ranges, clock = remembering(1.0)
-    ranges.scan = ring(0.4, 0.0)
+    ranges.scan = ring(0.1, 0.0)
     guard.drive(0.0, 0.0)
-    clock.now, base.pose = 1.5, Pose2D(0.3, 0.0, 0.0)
+    clock.now, base.pose = 1.5, Pose2D(0.0, 0.0, math.radians(60.0))  # as above, but 1.5 s later
     ranges.scan = ring(np.inf, 1.5)
-    guard.drive(0.3, 0.0)
-    assert base.commands[-1] == (0.3, 0.0)
+    guard.drive(0.2, -0.8)
+    assert base.commands[-1] == (0.2, -0.8)

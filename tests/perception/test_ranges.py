@@ -34,3 +34,18 @@ def test_bumpers_by_the_side_they_face():
 def test_a_reading_for_every_sensor_and_bumper():
     with pytest.raises(ValueError, match="2 ranges for 1 sensors"):
         RangeScan((RangeSensor(0.0, 0.0, 0.0),), np.zeros(2), stamp=0.0)
+
+
+def test_a_sensor_with_a_reading_covers_its_cone_and_the_rest_is_blind():
+    front = RangeSensor(0.2, 0.0, 0.0, fov=math.radians(30.0), max_range=5.0)
+    side = RangeSensor(0.0, 0.2, math.pi / 2, fov=math.radians(30.0), max_range=5.0)
+    points = np.array([
+        [1.2, 0.0],    # 1.0 m along the front axis -> covered
+        [0.7, 0.2],    # 21.8 deg off the front axis (outside its 15 deg half-cone), not in the side cone -> blind
+        [0.0, 0.6],    # 0.4 m along the side axis, the side transducer not read yet (nan) -> blind
+        [6.0, 0.0],    # beyond the front's 5 m -> blind
+    ])
+    scan = RangeScan((front, side), np.array([0.5, np.nan]), 0.0)
+    assert scan.covers(points).tolist() == [True, False, False, False]
+    read = RangeScan((front, side), np.array([np.inf, 2.0]), 0.0)
+    assert read.covers(points).tolist() == [True, False, True, False]
