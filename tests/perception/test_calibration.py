@@ -148,10 +148,11 @@ def test_a_repeated_view_is_dropped_reported_and_changes_nothing(images):
     clean = calibrate_chessboard(images[:4], 9, 6, 0.025)
     result = calibrate_chessboard([images[0], *images[:4]], 9, 6, 0.025)
     assert result.repeated == ((1, 0),) and result.used == (0, 2, 3, 4) and result.rejected == ()
-    # calibrated again without it: as if it was never given (up to OpenCV's last bits)
+    # calibrated again without it: as if it was never given, up to where OpenCV's solver stops (two
+    # runs of the same call on CI differed by 1.6e-7 in k2; a view counted twice moves far more)
     a, b = result.camera, clean.camera
-    assert np.allclose([a.fx, a.fy, a.cx, a.cy, *a.dist], [b.fx, b.fy, b.cx, b.cy, *b.dist], rtol=1e-6, atol=1e-9)
-    assert np.allclose(result.per_view_errors, clean.per_view_errors, rtol=1e-6)
+    assert np.allclose([a.fx, a.fy, a.cx, a.cy, *a.dist], [b.fx, b.fy, b.cx, b.cy, *b.dist], rtol=1e-5, atol=1e-6)
+    assert np.allclose(result.per_view_errors, clean.per_view_errors, rtol=1e-4)
 
 
 def test_a_near_identical_view_is_refused(images):
