@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from perception.geometry import wrap_angles
+
 
 @dataclass(frozen=True, slots=True)
 class RangeSensor:
@@ -80,7 +82,7 @@ class RangeScan:
             if np.isnan(reading):
                 continue
             dx, dy = points[:, 0] - sensor.x, points[:, 1] - sensor.y
-            off = np.abs(np.angle(np.exp(1j * (np.arctan2(dy, dx) - sensor.heading))))
+            off = np.abs(wrap_angles(np.arctan2(dy, dx) - sensor.heading))
             covered |= (off <= sensor.fov / 2.0) & (np.hypot(dx, dy) <= sensor.max_range)
         return covered
 
