@@ -9,8 +9,10 @@ then take the shortest path (edge cost sigma_x + sigma_y), homing at each node t
 2. **Path**: :meth:`maps.roadmap.Roadmap.shortest_path` from the target homed at to the goal.
 3. **Edges**: each edge is replayed as stored, ``Rotate(angle1)``, ``Drive(distance)``,
    ``Rotate(angle2)`` (odometry units: the robot's odometry errors replay the way they were
-   learned), then homing to the edge's target removes the drift. A failed edge (a stall, the
-   target not found at its end) sends the robot back to step 1 and a new path.
+   learned), then homing to the edge's target removes the drift. A drive held short (the
+   collision monitor stops the robot before furniture beside the target, a stall) still makes
+   the second turn and homes from where it stopped, as the learning did (``homed_short``). A
+   failed edge (the target not found at its end) sends the robot back to step 1 and a new path.
 
 Choices where the paper is vague:
 
@@ -148,11 +150,18 @@ class NavigateToTarget(RoutineBehaviour):
             yield from self.back_off()
 
     def _edge(self, motion: EdgeMotion, name: str, targets: TargetImages) -> Step[None]:
-        """Replay an edge (rotate, drive, rotate), then home to its target."""
+        """Replay an edge (rotate, drive, rotate), then home to its target; a drive held short still
+        turns and homes from where it stopped (module docstring)."""
         yield from self.rotate(motion.angle1, f"edge to {name}: turning")
-        yield from self.drive(motion.distance, f"edge to {name}: driving")
+        held = yield from self.attempted(self.drive(motion.distance, f"edge to {name}: driving"))
         yield from self.rotate(motion.angle2, f"edge to {name}: turning")
-        yield from home(self, targets.get(name), HomingSettings.of(self))
+        try:
+            yield from home(self, targets.get(name), HomingSettings.of(self))
+        except Failed as exc:
+            raise Failed(f"{held}; homing from there: {exc}" if held else str(exc)) from None
+        if held:
+            assert self.result is not None
+            self._note(homed_short=self.result.homed_short + 1)
         self._visit(name)
 
     def _visit(self, name: str, first: bool = False) -> None:
@@ -170,7 +179,8 @@ class NavigateToTarget(RoutineBehaviour):
         if r is not None:
             yield from roadmap_figures({"goal": r.goal, "reached": r.reached, "localised_at": r.localised_at,
                                         "visited": list(r.visited), "random_moves": r.random_moves,
-                                        "rescans": r.rescans, "reason": r.reason}, "navigation")
+                                        "rescans": r.rescans, "homed_short": r.homed_short,
+                                        "reason": r.reason}, "navigation")
 
     def drawings(self) -> Iterator[Drawing]:
         roadmap = self.get_input(self.ROADMAP, None)

@@ -227,6 +227,15 @@ class RoutineBehaviour(BearingsBehaviour):
         yield from self.drive_to(pose.x, pose.y, what)
         yield from self.turn_to(pose.theta, what)
 
+    def attempted(self, motion: Step[None]) -> Step[str]:
+        """Run a motion; '' when it finished, the reason when it failed (held short by something in
+        the way, a stall), for a caller that goes on from wherever it stopped."""
+        try:
+            yield from motion
+        except Failed as exc:
+            return str(exc)
+        return ""
+
     def back_off(self, distance: float | None = None) -> Step[None]:
         """Move away from a contact after a stall (``distance`` signed; default 0.2 m against the last drive)."""
         step = -0.2 * self._last_direction if distance is None else distance

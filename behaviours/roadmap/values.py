@@ -102,7 +102,8 @@ class ScanRecord:
 @dataclass(frozen=True, slots=True)
 class NavigationResult:
     """How ``NavigateToTarget`` went: ``reached``; the first target matched from the unknown start;
-    the targets visited in order; random moves made; why it stopped when it failed."""
+    the targets visited in order; random moves made; rescans; edges whose drive was held short and
+    homed from there; why it stopped when it failed."""
 
     goal: str
     reached: bool
@@ -110,4 +111,5 @@ class NavigationResult:
     visited: tuple[str, ...] = ()
     random_moves: int = 0
     rescans: int = 0
+    homed_short: int = 0  # edges whose drive was held short, then homed from there
     reason: str = ""

@@ -3,15 +3,18 @@
 The harness owns the blackboard and the manual clock; :meth:`FakeWorld.step` (the harness's
 ``between``) plays the drivers and the data-gathering branch: it moves the odometry exactly as
 commanded (no slip: odometry is the truth, in the frame of ``start``), refuses a move into an
-obstacle (the stall flag, as the simulator does), levels the pan-tilt head at once when told,
-and while the robot is at rest writes the images its cameras see, rendered by the simulator at
-the true pose. Rendering only at rest keeps tests fast: a behaviour takes images at rest anyway.
+obstacle (the stall flag, as the simulator does), refuses without a stall a move that ``hold``
+names (the collision monitor stopping the robot before something it senses), levels the pan-tilt
+head at once when told, and while the robot is at rest writes the images its cameras see,
+rendered by the simulator at the true pose. Rendering only at rest keeps tests fast: a behaviour
+takes images at rest anyway.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from typing import Any
 
 from behaviours.roadmap.values import TargetImages, TargetView
@@ -27,11 +30,13 @@ class FakeWorld:
     """Odometry, stall flag, pan-tilt state and camera frames for one behaviour under test."""
 
     def __init__(self, world: str = "lab", start: Pose2D | None = None, cameras: tuple[str, ...] = ("front",),
-                 *, pan: float = 0.0, turn_gain: float = 1.0) -> None:
+                 *, pan: float = 0.0, turn_gain: float = 1.0,
+                 hold: Callable[[Pose2D, Pose2D], bool] | None = None) -> None:
         self.sim = Simulation.load(world, seed=0, noise=False)
         self.start = start if start is not None else Pose2D(2.0, 2.0, 0.0)
         self.cameras = cameras
         self.turn_gain = turn_gain  # true turn / turn the odometry counts (1: odometry is the truth)
+        self.hold = hold  # (true pose, next true pose) -> the move is refused without a stall (a monitor's stop)
         self.odometry = Pose2D()
         self.true = self.start
         self.head = PanTiltState(pan, 0.0, False)
@@ -70,6 +75,8 @@ class FakeWorld:
         if blocked:
             self.contacts += 1
             moved, true = pose, here
+        elif self.hold is not None and self.hold(here, true):
+            moved, true = pose, here
         self.true = true
         at_rest = (moved.x, moved.y, moved.theta) == (pose.x, pose.y, pose.theta)
         self.odometry = Pose2D(moved.x, moved.y, moved.theta, harness.clock.now() + dt)
@@ -98,3 +105,12 @@ def target_images(world: FakeWorld, poses: dict[str, Pose2D], camera: str = "fro
         image = world.sim.snapshot(pose, camera, pan=0.0, tilt=0.0).image
         views.append(TargetView(name, image, describe(image), None, f"{name}.png"))
     return TargetImages(tuple(views))
+
+
+def rope(x: float, y: float, half_width: float = 0.05) -> Callable[[Pose2D, Pose2D], bool]:
+    """A ``hold`` that refuses every move of the robot's centre across the line y = ``y`` within
+    ``half_width`` of ``x``: something only a drive along x = ``x`` meets, the monitor holding the
+    robot before it."""
+    def crosses(here: Pose2D, there: Pose2D) -> bool:
+        return (here.y - y) * (there.y - y) <= 0.0 and here.y != there.y and abs(here.x - x) < half_width
+    return crosses

@@ -16,7 +16,7 @@ from behaviours.testing import BehaviourHarness
 from maps.roadmap import Roadmap
 from maps.room import RoomEstimate
 from perception.geometry import Pose2D
-from tests.behaviours.fake_world import FakeWorld, error_to, target_images
+from tests.behaviours.fake_world import FakeWorld, error_to, rope, target_images
 
 A, B = Pose2D(4.0, 3.0, 0.0), Pose2D(4.0, 1.8, 0.0)  # lab world frame
 REFERENCE = Pose2D(3.6, 2.4, 0.3)  # where the reference image is taken: the origin of the reference frame
@@ -68,7 +68,7 @@ def test_drives_the_pair_there_and_back_and_fuses_the_edge(tmp_path):
     assert saved.names == ("A", "B") and len(saved.edges) == 1
     assert report_sections(harness.behaviour) == {"roadmap": {
         **roadmap_section(graph), "pairs_tried": 1, "dropped": [], "not_straight": [],
-        "saved": str(tmp_path / "lab.roadmap")}}
+        "homed_short": [], "saved": str(tmp_path / "lab.roadmap")}}
     assert [d.entity for d in harness.behaviour.drawings()] == ["roadmap/targets", "roadmap/targets/labels",
                                                                 "roadmap/graph"]
     assert list(harness.behaviour.drawings()) == []  # the same graph: not again
@@ -84,3 +84,19 @@ def test_a_failed_pair_returns_to_the_reference_is_dropped_and_the_graph_is_not_
     dropped = report_sections(harness.behaviour)["roadmap"]["dropped"]
     assert [(d["from"], d["to"]) for d in dropped][0] in (("A", "B"), ("B", "A"))
     assert harness.read("/map/roadmap").edges == ()  # the roadmap is written all the same
+
+
+def test_a_drive_held_short_of_the_far_target_homes_from_where_it_stopped():
+    # the monitor holds the robot 0.3 m before B on the straight line between them (furniture beside
+    # a target): the edge is still measured, homed pose to homed pose, and nothing is touched
+    world = FakeWorld(start=Pose2D(3.7, 2.8, 0.1), hold=rope(4.0, 2.1))
+    harness = setup_graph(world, target_images(world, {"A": A, "B": B}))
+    assert harness.tick_until(between=world.step, max_ticks=8000) == Status.SUCCESS
+    graph = harness.read("/map/roadmap")
+    truth = B.relative_to(A)
+    measured = graph.motion("A", "B").relative_pose()
+    assert measured.distance_to(truth) < 0.03 and abs(math.degrees(measured.theta - truth.theta)) < 1.0
+    short = report_sections(harness.behaviour)["roadmap"]["homed_short"]
+    assert sorted((s["from"], s["to"]) for s in short) == [("A", "B"), ("B", "A")]  # held both ways
+    assert all("no progress" in s["reason"] for s in short)
+    assert world.contacts == 0

@@ -15,7 +15,7 @@ from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
 from maps.roadmap import EdgeMotion, Roadmap
 from perception.geometry import Pose2D
-from tests.behaviours.fake_world import FakeWorld, error_to, target_images
+from tests.behaviours.fake_world import FakeWorld, error_to, rope, target_images
 
 A, B = Pose2D(4.0, 3.0, 0.0), Pose2D(4.0, 1.8, math.pi / 2)  # lab world frame
 COVARIANCE = np.diag([1e-4, 1e-4, 1e-4])
@@ -42,7 +42,7 @@ def test_localises_at_a_target_then_follows_the_edge_and_homes_at_the_goal():
     assert result.reached and result.localised_at == "A" and result.visited == ("A", "B")
     assert report_sections(harness.behaviour) == {"roadmap": {"navigation": {
         "goal": "B", "reached": True, "localised_at": "A", "visited": ["A", "B"], "random_moves": 0, "rescans": 0,
-        "reason": ""}}}
+        "homed_short": 0, "reason": ""}}}
     assert [d.entity for d in harness.behaviour.drawings()] == ["roadmap/targets", "roadmap/targets/labels",
                                                                 "roadmap/graph"]
     assert list(harness.behaviour.drawings()) == []  # the same roadmap: not again
@@ -74,3 +74,15 @@ def test_moves_randomly_while_nothing_matches_then_gives_up():
     navigation = report_sections(harness.behaviour)["roadmap"]["navigation"]
     assert navigation["random_moves"] == 2 and navigation["reason"] == result.reason and navigation["visited"] == []
     assert world.true_pose().distance_to(Pose2D(3.3, 2.7)) > 0.3  # it did move
+
+
+def test_a_drive_held_short_of_the_next_target_still_turns_and_homes_from_there():
+    # the monitor holds the robot 0.3 m before B on the edge's straight line (furniture beside B)
+    world = FakeWorld(start=Pose2D(3.3, 2.7, 0.3), hold=rope(4.0, 2.1))
+    harness = navigate(world, target_images(world, {"A": A, "B": B}), target="B")
+    assert harness.tick_until(between=world.step, max_ticks=8000) == Status.SUCCESS
+    distance, heading = error_to(world, B)
+    assert distance < 0.03 and heading < 1.0
+    result = harness.read("/map/navigation")
+    assert result.visited == ("A", "B") and result.homed_short == 1 and result.rescans == 0
+    assert world.contacts == 0
