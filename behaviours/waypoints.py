@@ -32,6 +32,8 @@ class DriveWaypoints(OdometryMotion):
 
     The intermediate waypoints are passed within ``tolerance`` without stopping when the next
     leg goes on straight; the robot stops and turns where the route bends by more than 30 deg.
+    Each command says how far the robot goes before it stops (``reach``: to the next bend or the
+    end), so an avoidance judges the way no farther than that.
     """
 
     WAYPOINTS = InputPort("waypoints", list[float], unit="m", doc="x0, y0, x1, y1, ... in the odometry frame")
@@ -63,7 +65,7 @@ class DriveWaypoints(OdometryMotion):
         remaining = distance + self._straight_on(self.index)
         v = 0.0 if abs(error) > DriveTo.TURN_IN_PLACE else ramp(remaining, self.get_input(self.SPEED),
                                                                  LINEAR_DECEL, MIN_SPEED) * math.cos(error)
-        self.command(v, w)
+        self.command(v, w, remaining)  # where it stops next (a bend or the end): the goal of this command
         self.feedback_message = f"waypoint {self.index + 1} of {len(self.points)}: {distance:.2f} m to go"
         return Status.RUNNING
 

@@ -19,11 +19,16 @@ the robot's odometry. Three phases:
   wish passes; ``clear_time`` of that ends the detour, and the motion node steers back to its
   path by itself. A wish to stop or to back away passes (the collision monitor judges it). Where
   the wish heads is kept in the odometry frame from its last forward command, so that a wish to
-  turn on the spot (which says only which way) does not swing the choice as the robot turns. No
-  direction will do: stopped. With ``pass_turns`` a wish to turn on the spot passes in every
-  phase: a node that turns by a measured angle (the roadmap's random moves and scans) fails when
-  its turn does not happen; such a turn during a detour is the node's, not the detour's, and does
-  not count towards :data:`GOING_ROUND`.
+  turn on the spot (which says only which way) does not swing the choice as the robot turns. So
+  a wish to turn on the spot towards a goal (``reach``) nearer than anything sensed (every point
+  farther from the robot's centre than the goal and the footprint's farthest corner together)
+  ends the detour at once: the detour took the robot beside its goal (past a person, to a
+  waypoint now behind it), and a straight drive there, in whatever direction, touches nothing
+  (in an untuned office the detour went on along the corridor, its goal 0.35 m behind, until it
+  gave up after 6 m). No direction will do: stopped. With ``pass_turns`` a wish to turn on the
+  spot passes in every phase: a node that turns by a measured angle (the roadmap's random moves
+  and scans) fails when its turn does not happen; such a turn during a detour is the node's, not
+  the detour's, and does not count towards :data:`GOING_ROUND`.
 
 Backing away (``backoff``): when, after the wait or ``wait`` seconds into a detour's hold, no
 direction will do for the obstacles around (not merely for straying), the robot backs along its
@@ -265,15 +270,13 @@ class Avoidance:
         if v < 0.0 or (v == 0.0 and w == 0.0):  # backing away (from a stall), stopping: the monitor's to judge
             episode.clear_since = None
             return Decision(v, w, "detour", passed=True)
+        if v == 0.0 and self._goal_free(around, reach):  # turning to a goal nothing sensed is as near as: done
+            return self._detour_done(episode, v, w, now, f"the goal {reach:.2f} m away, nothing nearer")
         if v > 0.0 and not stopped and not self._blocked(v, w, around, at_least=self._reach(v), reach=reach):
             episode.held_since = None
             episode.clear_since = now if episode.clear_since is None else episode.clear_since
             if now - episode.clear_since >= self.settings.clear_time:
-                length, took = episode.length, now - (episode.detour_start or now)
-                self._end_detour(episode, now)
-                self.phase, self._episode = "clear", None
-                return Decision(v, w, "clear", event=f"past the obstacle: a detour of {length:.2f} m in {took:.1f} s",
-                                passed=True)
+                return self._detour_done(episode, v, w, now, "past the obstacle")
             return Decision(v, w, "detour", passed=True)
         episode.clear_since = None
         choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode),
@@ -291,6 +294,24 @@ class Avoidance:
                 return self._give_up(self._blocked_reason(now - episode.held_since, v, w, around.points, choice), now)
         episode.side = episode.side or choice.side
         return Decision(*command, "detour", choice)
+
+    def _goal_free(self, around: Surroundings, reach: float) -> bool:
+        """Is every sensed point farther from the robot's centre than the goal is (``reach``) plus the
+        footprint's farthest corner? Then a straight drive to the goal, in whatever direction it lies,
+        touches nothing: no detour is needed to get there (the goal may lie nearer something than the
+        clearance, as a wish's goal may; the wish after the turn is judged with the clearance)."""
+        if not math.isfinite(reach):
+            return False
+        corner = float(np.max(np.hypot(*self.avoid.footprint.T)))
+        nearest = float(np.min(np.hypot(*around.points.T))) if len(around.points) else math.inf
+        return nearest > reach + corner
+
+    def _detour_done(self, episode: _Episode, v: float, w: float, now: float, why: str) -> Decision:
+        """End a detour that did its work; the wish passes."""
+        length, took = episode.length, now - (episode.detour_start or now)
+        self._end_detour(episode, now)
+        self.phase, self._episode = "clear", None
+        return Decision(v, w, "clear", event=f"{why}: a detour of {length:.2f} m in {took:.1f} s", passed=True)
 
     def _detour_over(self, episode: _Episode, pose: Pose2D, now: float) -> str:
         """Why a detour gives up now ("" while it goes on): too long, going round, or getting nowhere."""

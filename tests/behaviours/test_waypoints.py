@@ -52,3 +52,18 @@ def test_waypoints_come_in_pairs():
         waypoint_pairs([1.0, 2.0, 3.0])
     with pytest.raises(ValueError, match="no waypoints"):
         DriveWaypoints(waypoints=[])
+
+
+def test_each_command_says_how_far_the_robot_goes_before_it_stops():
+    # (1, 0) then (2, 0) straight on, then a right-angle bend to (2, 1): from the start the robot
+    # stops first at (2, 0), 2 m away; past the bend it stops at the end
+    harness = BehaviourHarness(DriveWaypoints(waypoints=[1.0, 0.0, 2.0, 0.0, 2.0, 1.0]),
+                               blackboard={"/robot/odometry": Pose2D()})
+    harness.tick()
+    assert harness.read("/robot/command").reach == pytest.approx(2.0)
+    harness.write("/robot/odometry", Pose2D(1.0, 0.0, 0.0))  # at (1, 0): on to the bend
+    harness.tick()
+    assert harness.read("/robot/command").reach == pytest.approx(1.0)
+    harness.write("/robot/odometry", Pose2D(2.0, 0.0, math.pi / 2))  # at the bend, turned
+    harness.tick()
+    assert harness.read("/robot/command").reach == pytest.approx(1.0)

@@ -279,3 +279,27 @@ def test_a_detour_ends_once_the_wishs_goal_lies_short_of_the_obstacle():
     assert a.step(0.3, 0.0, PERSON, HERE, 0.2, reach=0.2).passed  # the node now stops 0.2 m on
     end = a.step(0.3, 0.0, PERSON, HERE, 1.2, reach=0.2)
     assert end.phase == "clear" and end.event.startswith("past the obstacle")
+
+
+def test_a_detour_ends_when_the_wish_turns_to_a_goal_nothing_sensed_is_as_near_as():
+    a = avoidance(wait=2.0)
+    for t in np.arange(0.0, 2.1, 0.1):
+        decision = a.step(0.3, 0.0, PERSON, HERE, float(t))
+    assert decision.phase == "detour"
+    # beside the person now, 0.9 m off them; the goal 0.3 m behind: the wish turns on the spot
+    beside = Pose2D(0.6, 0.9, 0.0)
+    person = np.array([[0.0, -0.9]])  # where the person is, seen from there
+    far = a.step(0.0, 0.5, person, beside, 2.5, reach=0.7)  # 0.7 + 0.26 = 0.96 > 0.9: not yet
+    assert far.phase == "detour" and not far.passed
+    near = a.step(0.0, 0.5, person, beside, 2.6, reach=0.3)  # 0.3 + 0.26 = 0.56 < 0.9: a straight drive is free
+    assert near.passed and near.phase == "clear" and (near.v, near.w) == (0.0, 0.5)
+    assert near.event.startswith("the goal 0.30 m away, nothing nearer: a detour of")
+    assert a.tally.detours == 1 and a.phase == "clear"
+
+
+def test_a_wish_turning_on_the_spot_without_a_goal_in_sight_does_not_end_a_detour():
+    a = avoidance(wait=2.0)
+    for t in np.arange(0.0, 2.1, 0.1):
+        a.step(0.3, 0.0, PERSON, HERE, float(t))
+    turning = a.step(0.0, 0.5, NOTHING, Pose2D(0.6, 0.9, 0.0), 2.5)  # reach: inf
+    assert turning.phase == "detour" and not turning.passed
