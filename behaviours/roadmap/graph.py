@@ -73,7 +73,7 @@ import numpy as np
 from behaviours.ports import WRITES, InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import Drawn, roadmap_drawings, roadmap_figures, roadmap_section
-from behaviours.roadmap.homing import REQUIRED_ROOM, HomingSettings, home
+from behaviours.roadmap.homing import REQUIRED_ROOM, HomingSettings, home, home_after
 from behaviours.roadmap.paths import PLAN_PORTS, reanchored, travel
 from behaviours.roadmap.room import ROOM_IN
 from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step, robot_disc
@@ -261,10 +261,7 @@ class BuildGraph(RoutineBehaviour):
         what = f"edge {a} -> {b}"
         held = yield from self.attempted(self.drive_to(goal.x, goal.y, what))
         yield from self.turn_to(goal.theta, what)
-        try:
-            result = yield from home(self, view, settings)
-        except Failed as exc:
-            raise Failed(f"{held}; homing from there: {exc}" if held else str(exc)) from None
+        result = yield from home_after(self, view, settings, held)
         if held:
             self.log.homed_short.append({"from": a, "to": b, "reason": held})
         self._homed(b, result.pose)

@@ -184,6 +184,16 @@ def home(host: RoutineBehaviour, target: TargetView, settings: HomingSettings) -
     raise Failed(f"homing on {target.name} did not converge in {settings.max_rounds} rounds")
 
 
+def home_after(host: RoutineBehaviour, target: TargetView, settings: HomingSettings, held: str
+               ) -> Step[HomingResult]:
+    """:func:`home` after a motion towards ``target``; ``held``: why that motion stopped short of its
+    end ('' when it arrived), named in the failure (a drive held short homes from where it stopped)."""
+    try:
+        return (yield from home(host, target, settings))
+    except Failed as exc:
+        raise Failed(f"{held}; homing from there: {exc}" if held else str(exc)) from None
+
+
 def _go(host: RoutineBehaviour, goal: Pose2D, what: str) -> Step[None]:
     """Drive to an odometry pose: along a planned path when a room estimate is known and the goal is
     farther than ``PLANNED_BEYOND`` (homing from afar must not run into the furniture in between),

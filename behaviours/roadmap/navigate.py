@@ -37,7 +37,7 @@ import numpy as np
 from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.roadmap.display import Drawn, roadmap_drawings, roadmap_figures
-from behaviours.roadmap.homing import HOMING_PORTS, HomingSettings, home
+from behaviours.roadmap.homing import HOMING_PORTS, HomingSettings, home, home_after
 from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.scan import scan
 from behaviours.roadmap.values import NavigationResult, TargetImages
@@ -155,10 +155,7 @@ class NavigateToTarget(RoutineBehaviour):
         yield from self.rotate(motion.angle1, f"edge to {name}: turning")
         held = yield from self.attempted(self.drive(motion.distance, f"edge to {name}: driving"))
         yield from self.rotate(motion.angle2, f"edge to {name}: turning")
-        try:
-            yield from home(self, targets.get(name), HomingSettings.of(self))
-        except Failed as exc:
-            raise Failed(f"{held}; homing from there: {exc}" if held else str(exc)) from None
+        yield from home_after(self, targets.get(name), HomingSettings.of(self), held)
         if held:
             assert self.result is not None
             self._note(homed_short=self.result.homed_short + 1)
