@@ -15,7 +15,7 @@ import numpy as np
 
 from behaviours.keys import FOOTPRINT_KEY
 from behaviours.ports import InputPort, Ref
-from perception.polygons import as_polygon, disc
+from perception.polygons import as_polygon, disc, enclosing_radius
 
 DEFAULT_RADIUS = 0.26  # m: a Pioneer 3-DX's RobotRadius (ARIA's p3dx.p), the simulator's default disc
 DEFAULT_FOOTPRINT = disc(DEFAULT_RADIUS)
@@ -26,12 +26,6 @@ def footprint_of(node: object) -> np.ndarray:
     """The footprint ``node`` reads on its :data:`FOOTPRINT` port (:data:`DEFAULT_FOOTPRINT` when
     nothing published one), as a counter-clockwise polygon."""
     return as_polygon(node.get_input(FOOTPRINT, DEFAULT_FOOTPRINT))  # type: ignore[attr-defined]
-
-
-def enclosing_radius(footprint: np.ndarray) -> float:
-    """The radius of the disc about the base's centre that holds ``footprint`` (what turning on the
-    spot sweeps)."""
-    return float(np.max(np.hypot(footprint[:, 0], footprint[:, 1])))
 
 
 def robot_radius(node: object, given: float) -> float:

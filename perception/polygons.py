@@ -113,6 +113,12 @@ def rectangle(front: float, rear: float, half_width: float) -> np.ndarray:
     return np.array([[front, -half_width], [front, half_width], [-rear, half_width], [-rear, -half_width]])
 
 
+def enclosing_radius(poly: np.ndarray) -> float:
+    """The radius of the disc about the origin that holds ``poly`` (for a footprint in the base
+    frame: what turning on the spot sweeps)."""
+    return float(np.max(np.hypot(poly[:, 0], poly[:, 1])))
+
+
 def disc(radius: float, sides: int = 32) -> np.ndarray:
     """A regular polygon that contains the disc of ``radius`` (its edges touch the circle)."""
     outer = radius / math.cos(math.pi / sides)

@@ -72,7 +72,7 @@ from maps.avoidance.backoff import STEP, BackoffSettings, Trail, back_command
 from maps.avoidance.directions import Choice, choose, steer, wished_direction
 from maps.avoidance.sweep import AvoidSettings, DetourLine, Surroundings, free_distance, needed_distance
 from perception.geometry import Pose2D, wrap_angle
-from perception.polygons import distance
+from perception.polygons import distance, enclosing_radius
 
 Phase = Literal["clear", "waiting", "detour", "backoff"]
 GOING_ROUND = math.pi  # rad: a detour that has turned this much is going round the obstacle, not past it
@@ -302,9 +302,8 @@ class Avoidance:
         clearance, as a wish's goal may; the wish after the turn is judged with the clearance)."""
         if not math.isfinite(reach):
             return False
-        corner = float(np.max(np.hypot(*self.avoid.footprint.T)))
         nearest = float(np.min(np.hypot(*around.points.T))) if len(around.points) else math.inf
-        return nearest > reach + corner
+        return nearest > reach + enclosing_radius(self.avoid.footprint)
 
     def _detour_done(self, episode: _Episode, v: float, w: float, now: float, why: str) -> Decision:
         """End a detour that did its work; the wish passes."""
