@@ -86,3 +86,5 @@ class RunArguments(BaseModel):
     seed: Seed = Field(0, alias="--seed")
     image_rate: float | None = Field(None, ge=0.0, le=1000.0, alias="--image-rate",
                                      description="camera images per second in a recording; 0: every frame")
+    trace: float | None = Field(None, gt=0.0, le=3600.0, alias="--trace",
+                                description="a trace line every this many seconds of run time")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +25,7 @@ from missions.progress import progress_for
 from missions.runner import Runner, RunOptions
 from missions.safety import Interrupted, early_signals, exit_code
 from missions.summary import summary_line
+from missions.trace import Trace
 from perception.collision_monitor import MonitorConfig
 from perception.geometry import Pose2D
 from perception.polygons import disc
@@ -91,6 +93,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress line")
     parser.add_argument("--progress", action="store_true",
                         help="print progress even when stderr is not a terminal: a line every few seconds")
+    parser.add_argument("--trace", type=float, metavar="S",
+                        help="print a line every S seconds of run time on stdout: the command, the collision "
+                        "monitor, the avoidance's phase, every running behaviour's feedback; in the simulator also "
+                        "the true pose, the nearest people and every new closest approach under 5 cm")
     parser.add_argument("--debug", action="store_true", help="print the traceback when a behaviour raises")
     add_mission_options(parser)
     parser.set_defaults(func=run)
@@ -139,9 +145,10 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
         clock = Paced(clock, engaged=args.realtime)
         keyboard = paced_when_operated(TerminalKeys, clock, said=lambda line: print(line, file=sys.stderr))
     progress = progress_for(mission.name, sys.stderr, asked=args.progress, quiet=args.quiet)
+    trace = None if numbers.trace is None else Trace(numbers.trace, sys.stdout)
     try:
         result = Runner(mission, robot, clock=clock, options=options, observers=[simulation] if simulation else [],
-                        on_tick=progress, keyboard=keyboard, safety=safety).run()
+                        on_tick=_every_tick(progress, trace), keyboard=keyboard, safety=safety).run()
     finally:
         if progress is not None:
             progress.close()
@@ -162,9 +169,21 @@ def _run(args: argparse.Namespace, mission: Any, opened: tuple[Any, Robot, TickC
     return result.exit_code
 
 
+def _every_tick(*hooks: Callable[[Runner], None] | None) -> Callable[[Runner], None] | None:
+    """The runner's ``on_tick``: each of ``hooks`` given, in turn (None when none is)."""
+    given = [hook for hook in hooks if hook is not None]
+    if len(given) <= 1:
+        return given[0] if given else None
+
+    def both(runner: Runner) -> None:
+        for hook in given:
+            hook(runner)
+    return both
+
+
 def _numbers(args: argparse.Namespace) -> RunArguments:
     given = {"--rate": args.rate, "--max-time": args.max_time, "--overrun": args.overrun, "--seed": args.seed,
-             "--image-rate": args.image_rate}
+             "--image-rate": args.image_rate, "--trace": args.trace}
     return validate(RunArguments, {k: v for k, v in given.items() if v is not None}, file="command line")
 
 
