@@ -4,6 +4,12 @@ Walls and box faces become line segments, pillars and people circles; each surfa
 texture sits in the atlas. Everything here is vectorised over rays and surfaces with numpy, so one
 panorama's 720 column rays against a few dozen surfaces cost a handful of array operations.
 
+A box pushed against a wall has a face in the wall's plane; seen from the wall's other side the two
+lie at the same distance and the nearest of them changed from column to column with the rounding,
+striping the wall with the box (found in a world written for a test). The box is always on the
+far side (its face towards the viewer is in the wall), so a column takes the wall when a box face
+is within :data:`FLUSH` of it.
+
 People are the scene's only moving surfaces: circles after the pillars whose centres the
 simulation moves each step (:meth:`Scene.move_people`), so every camera, the bearings sensor's
 occlusion and the sonar see them where they are now. :meth:`Scene.clearance` (collisions, free
@@ -23,6 +29,7 @@ from drivers.sim.world_values import Person, Pillar, TextureSpec, World
 from perception.geometry import Pose2D
 
 EPS = 1e-9
+FLUSH = 1e-4  # m: a box face this near a wall along a column ray counts as behind it (module docstring)
 SKY_PX_PER_RAD = 60.0  # texels per radian of the sky / far-ground bands
 SKY_TOP = math.radians(90.0)
 
@@ -78,6 +85,7 @@ class Scene:
         self.circle_xy = np.asarray(centres, dtype=float).reshape(-1, 2)
         self.circle_r = np.asarray([p.radius for p in rounds], dtype=float)
         self._pillar_index = np.arange(n_segments, self.n_surfaces)
+        self._box_face = np.concatenate([~self.seg_two_sided, np.zeros(self.n_surfaces - n_segments, dtype=bool)])
         ends = [p for wall in world.walls if wall.points[0] != wall.points[-1]
                 for p in (wall.points[0], wall.points[-1])]
         self.wall_ends = np.asarray(ends, dtype=float).reshape(-1, 2)  # open ends of walls: door jambs, wall ends
@@ -232,8 +240,9 @@ class Scene:
             return out
         cols = np.arange(len(angles))
         top = (self.heights[index] - eye_z) / dist if n_layers > 1 else None  # tangent of each top edge
+        behind = np.where(self._box_face[index], FLUSH, 0.0)  # a box face flush with a wall: the wall first
         for layer in range(n_layers):
-            j = np.argmin(dist, axis=1)
+            j = np.argmin(dist + behind, axis=1)
             d = dist[cols, j]
             found = d < np.inf
             if not found.any():

@@ -138,3 +138,21 @@ def test_landmark_discs_are_drawn_where_the_model_projects_them_and_hidden_like_
             np.testing.assert_allclose(centre, uv[0], atol=0.75)
         else:
             assert rows.size == 0, lm.id
+
+
+def test_a_box_pushed_against_a_wall_never_shows_through_it_from_the_other_side(sim_from) -> None:
+    """A wall along y = 0 and a box south of it whose north face lies in the wall (x 1-3): seen from
+    the north every column on the wall's face takes the wall, none the box face behind it (the two
+    at one distance, the nearer changed with the rounding: stripes)."""
+    sim = sim_from(PLAIN + "start: {x: 0, y: 2}\nwalls: [{points: [[-4, 0], [6, 0]], height: 2.5}]\n"
+                   "boxes: [{center: [2.0, -0.5], size: [2.0, 1.0], height: 0.8}]\n")
+    scene = sim.scene
+    scene.ensure_textures()
+    wall = int(np.flatnonzero(scene.seg_two_sided)[0])
+    for viewer_x in (1.3, 2.0, 2.77):  # the angles to the face's span differ: the rounding with them
+        origin = np.array([viewer_x, 1.7])
+        tips = np.linspace(1.0 + 1e-3, 3.0 - 1e-3, 997)  # the hits along the box's face, in the wall
+        angles = np.arctan2(0.0 - origin[1], tips - origin[0])
+        nearest = scene.layers(origin, CAMERA_Z, angles, 2)[0]
+        assert nearest.distance == pytest.approx(np.hypot(tips - origin[0], origin[1]), abs=1e-9)
+        assert set(nearest.surface.tolist()) == {wall}
