@@ -16,7 +16,9 @@ Episodes (all through the sweep runner, in the results folder), per seed:
    targets are added to a copy of the world file, ``seeds/<world>_s<seed>/<world>.yaml``, and that
    seed's snapshots, learn and goto episodes all run in the copy (self-contained, resumable).
 2. **Learn**: ``learn_targets`` from the world's start with that folder; it writes the roadmap to
-   ``seeds/<world>_s<seed>/<world>.roadmap``.
+   ``seeds/<world>_s<seed>/<world>.roadmap``. A start where the room estimation's dodecagon would
+   touch a surface (a hallway) is moved to the nearest reachable pose where it fits
+   (:func:`~experiments.eval.roadmap_world.learn_start`; the run's ``--start``).
 3. **Goto**: ``goto_target`` from ``--option starts=N`` random start poses (default 5;
    :func:`~experiments.eval.roadmap_world.random_starts`: uniform in the world's bounds, at least
    0.45 m clear of every surface, reachable, any heading, drawn from the seed alone), each to a goal
@@ -69,6 +71,7 @@ from experiments.eval import EvalOptions, count_option
 from experiments.eval import people as crowd
 from experiments.eval.figures import cell, interval_cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.roadmap_world import (
+    learn_start,
     place_targets,
     pose_error,
     random_starts,
@@ -238,11 +241,14 @@ def seed_targets(world: str, loaded: World, settings: Settings, seed: int, folde
     return SeedTargets(str(copy), poses)
 
 
-def learn_episode(world: str, seed: int, folder: Path, max_time_s: float | None) -> Episode:
-    """``learn_targets`` from the world's start with the seed's target images."""
+def learn_episode(world: str, seed: int, folder: Path, max_time_s: float | None, start: Pose2D | None = None
+                  ) -> Episode:
+    """``learn_targets`` with the seed's target images, from ``start`` (None: the world's start;
+    :func:`~experiments.eval.roadmap_world.learn_start` says where the room estimation fits)."""
     here = seed_folder(folder, world, seed)
     inputs = {"targets": str(here / "targets"), "roadmap": str(here / f"{Path(world).stem}.roadmap")}
-    return Episode(LEARN, world, seed, inputs, max_time_s)
+    where = None if start is None else f"{start.x:.4f},{start.y:.4f},{math.degrees(start.theta):.3f}deg"
+    return Episode(LEARN, world, seed, inputs, max_time_s, where)
 
 
 def goto_plans(learn: Episode, world: World, found: Sequence[str], starts: int,
@@ -403,6 +409,16 @@ def summarise(world: str, settings: Settings, learns: list[dict[str, Any]], goto
     return out
 
 
+def _moved_start(world: World, grid: FloorGrid) -> Pose2D | None:
+    """The learning's start when the world's own has no room for the room estimation (None: it has;
+    ``SweepInputError`` when no place has)."""
+    try:
+        start = learn_start(world, grid)
+    except ValueError as exc:
+        raise SweepInputError(str(exc)) from None
+    return None if (start.x, start.y, start.theta) == (world.start.x, world.start.y, world.start.theta) else start
+
+
 def _failure(run: Mapping[str, Any]) -> dict[str, Any]:
     what = f"goto {run['number']} to {run['goal']}" if run["episode"] == "goto" else "learn"
     return {"seed": run["seed"], "episode": what, "status": run["status"], "reason": run["reason"]}
@@ -413,8 +429,9 @@ def _failure(run: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _learn_phase(options: EvalOptions, targets: Mapping[int, SeedTargets], settings: Settings, folder: Path,
-                 resume: bool) -> tuple[dict[int, Episode], dict[str, dict[str, Any]]]:
-    episodes = {seed: learn_episode(targets[seed].world, seed, folder, options.max_time_s) for seed in options.seeds}
+                 resume: bool, start: Pose2D | None) -> tuple[dict[int, Episode], dict[str, dict[str, Any]]]:
+    episodes = {seed: learn_episode(targets[seed].world, seed, folder, options.max_time_s, start)
+                for seed in options.seeds}
     for seed, episode in episodes.items():
         write_target_images(targets[seed].world, settings.targets, Path(episode.inputs["targets"]), seed=seed)
     rows = run_sweep(list(episodes.values()), executor=options.executor, results_dir=folder,
@@ -431,7 +448,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     targets = {seed: seed_targets(world, loaded, settings, seed, folder, grid) for seed in options.seeds}
     truth = {seed: t.poses for seed, t in targets.items()}
     navigate_in, people = navigation_worlds(loaded, settings, targets, folder, grid)
-    episodes, rows = _learn_phase(options, targets, settings, folder, resume)
+    episodes, rows = _learn_phase(options, targets, settings, folder, resume, _moved_start(loaded, grid))
     learns, plans = [], []
     for seed, episode in sorted(episodes.items()):
         figures = learn_figures(seed, read_report(folder, episode.id), rows.get(episode.id), truth[seed])

@@ -54,10 +54,12 @@ import numpy as np
 import yaml
 from scipy import ndimage
 
+from behaviours.roadmap.room import RoomEstimationDodecagon
 from drivers.sim.cameras import camera_pose
 from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, load_world, shipped_worlds
+from maps.room import CORNERS
 from missions.cli import main
 from perception.geometry import Pose2D, wrap_angle, wrap_angles
 
@@ -72,6 +74,8 @@ MIN_SURFACES = 2  # distinct surfaces a placed target's view must meet (one flat
 TARGET_DRAWS = 10_000  # draws for a placed target at TARGET_CLEARANCE before START_CLEARANCE is tried
 TARGET_CANDIDATES = 3  # positions drawn per placed target; the one with the best view is kept
 PREFERRED_CENTRE = (2.0, 4.0)  # m: a placed target's optical axis preferably meets its surface this far away
+DODECAGON_MARGIN = 0.35  # m spare round the dodecagon at a moved start: the monitor's slow-down margin
+LEARN_HEADINGS = 12  # headings tried at each place for a learning start (every 30 deg)
 
 T = TypeVar("T")
 
@@ -326,6 +330,41 @@ def best_heading(free: FreeFloor, x: float, y: float, azimuths: np.ndarray, *,
     axis nearest the band's middle (:meth:`HeadingChoice.key`); None if none qualifies."""
     choices = heading_choices(free, x, y, azimuths, view_range=view_range, camera=camera)
     return max(choices, key=HeadingChoice.key) if choices else None
+
+
+def learn_start(world: World, grid: FloorGrid, side: float = RoomEstimationDodecagon.SIDE.default) -> Pose2D:
+    """Where ``learn_targets`` starts: the world's start when the room estimation's dodecagon fits
+    there (the robot's disc clears every surface all round the corners' circle, whose centre lies
+    side / (2 sin 15 deg) to the robot's left), else the reachable pose nearest to it where it does
+    with :data:`DODECAGON_MARGIN` to spare (the lab's start has 0.06 m and is kept; a start moved
+    is moved to where the collision monitor neither stops nor slows the drives: with 0.10 m, its
+    stop margin, `flat`'s learning was stopped at the tenth corner). The method expects the
+    robot in a room (the paper's); a world may start it in a hallway (``flat``: 1.4 m wide, where
+    the learning failed at its second corner), and a user would carry it into a room. ValueError
+    when no reachable place has the room."""
+    circle = side / (2.0 * math.sin(math.pi / CORNERS))
+    scene = Scene(world)
+
+    def centre(x: float, y: float, theta: float) -> tuple[float, float]:
+        return x - circle * math.sin(theta), y + circle * math.cos(theta)
+
+    start = world.start
+    if scene.clearance(*centre(start.x, start.y, start.theta)) >= circle + world.robot_radius:
+        return Pose2D(start.x, start.y, start.theta)
+    need = circle + world.robot_radius + DODECAGON_MARGIN
+    room = ndimage.distance_transform_edt(grid.free) * grid.resolution  # generous by a cell: exact check below
+    cells = floor_cells(grid)
+    for i in np.argsort(np.hypot(cells[:, 0] - start.x, cells[:, 1] - start.y)):
+        x, y = (float(c) for c in cells[i])
+        for k in range(LEARN_HEADINGS):
+            theta = wrap_angle(start.theta + 2.0 * math.pi * k / LEARN_HEADINGS)
+            cx, cy = centre(x, y, theta)
+            col, row = int((cx - grid.x0) / grid.resolution), int((cy - grid.y0) / grid.resolution)
+            inside = 0 <= row < room.shape[0] and 0 <= col < room.shape[1]
+            if inside and room[row, col] + grid.resolution >= need and scene.clearance(cx, cy) >= need:
+                return Pose2D(x, y, theta)
+    raise ValueError(f"world {world.name!r} has no reachable place where the room estimation's dodecagon (side "
+                     f"{side:g} m) fits: a free disc {2.0 * need:.2f} m across")
 
 
 def has_room(grid: FloorGrid, clearance: float) -> bool:

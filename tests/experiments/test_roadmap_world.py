@@ -1,0 +1,50 @@
+"""Where the roadmap evaluation starts a learning: where the room estimation's dodecagon fits."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import yaml
+
+from drivers.sim.scene import Scene
+from drivers.sim.world import load_world
+from experiments.eval.roadmap_world import learn_start, reachable_grid
+
+CIRCLE = 0.25 / (2.0 * math.sin(math.pi / 12))  # 0.4830 m: the corners' circle of a 0.25 m side
+# A 1.4 m hallway (y 0-1.4) from x = 0 to 6, opening at its east end into a 4 x 4 m room (x 6-10).
+HALLWAY = {
+    "name": "hall", "start": {"x": 0.8, "y": 0.7, "theta_deg": 0},
+    "walls": [{"points": [[0, 0], [6, 0], [6, -1.3], [10, -1.3], [10, 2.7], [6, 2.7], [6, 1.4], [0, 1.4]],
+               "closed": True, "height": 2.5}],
+}
+
+
+def world_file(tmp_path, data):
+    path = tmp_path / f"{data['name']}.yaml"
+    path.write_text(yaml.safe_dump({"format": 1, **data}))
+    return load_world(path)
+
+
+def test_a_start_with_room_for_the_dodecagon_is_kept():
+    lab = load_world("lab")  # its start has 0.06 m to spare round the robot's disc: kept as it is
+    start = learn_start(lab, reachable_grid(lab))
+    assert (start.x, start.y, start.theta) == (lab.start.x, lab.start.y, lab.start.theta)
+
+
+def test_a_start_in_a_hallway_moves_to_the_nearest_pose_where_the_dodecagon_fits_with_a_margin(tmp_path):
+    world = world_file(tmp_path, HALLWAY)
+    start = learn_start(world, reachable_grid(world))
+    centre = (start.x - CIRCLE * math.sin(start.theta), start.y + CIRCLE * math.cos(start.theta))
+    # the corners' circle, the robot's 0.26 m disc and the monitor's 0.35 m slow-down margin: 1.093 m
+    assert Scene(world).clearance(*centre) >= CIRCLE + 0.26 + 0.35
+    assert 6.0 < centre[0] < 10.0  # in the room: the hallway's 0.7 m to each wall is too little
+    assert start.x < 7.5  # the nearest such pose: near the room's entrance, not its far side
+
+
+def test_a_world_with_no_room_anywhere_says_so(tmp_path):
+    narrow = {**HALLWAY, "name": "narrow",
+              "walls": [{"points": [[0, 0], [6, 0], [6, 1.4], [0, 1.4]], "closed": True, "height": 2.5}]}
+    world = world_file(tmp_path, narrow)
+    with pytest.raises(ValueError, match="no reachable place where the room estimation's dodecagon"):
+        learn_start(world, reachable_grid(world))
