@@ -340,7 +340,7 @@ def learn_start(world: World, grid: FloorGrid, side: float = RoomEstimationDodec
     is moved to where the collision monitor neither stops nor slows the drives: with 0.10 m, its
     stop margin, `flat`'s learning was stopped at the tenth corner). The method expects the
     robot in a room (the paper's); a world may start it in a hallway (``flat``: 1.4 m wide, where
-    the learning failed at its second corner), and a user would carry it into a room. ValueError
+    the learning was stopped at its fourth corner), and a user would carry it into a room. ValueError
     when no reachable place has the room."""
     circle = side / (2.0 * math.sin(math.pi / CORNERS))
     scene = Scene(world)
