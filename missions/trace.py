@@ -66,8 +66,8 @@ def line(runner: Any, now: float, truth: Truth | None) -> str:
     """One trace line (module docstring)."""
     command = runner.last_command
     parts = [f"t={now:7.1f}"]
-    if truth is not None:
-        pose = truth.true_pose()
+    pose = None if truth is None else truth.true_pose()
+    if pose is not None:
         parts.append(f"true=({pose.x:.2f},{pose.y:.2f},{math.degrees(pose.theta):4.0f}deg)")
     parts.append(f"cmd=({command.v:.2f},{command.w:.2f})")
     parts.append(f"safety={runner.guard.state.state}")
@@ -75,8 +75,8 @@ def line(runner: Any, now: float, truth: Truth | None) -> str:
     phases = [node.avoidance.phase for node in running if isinstance(node, AvoidObstacles)]
     if phases:
         parts.append("avoid=" + ",".join(phases))
-    if truth is not None:
-        parts.extend(_people(truth, truth.true_pose()))
+    if truth is not None and pose is not None:
+        parts.extend(_people(truth, pose))
     leaves = [node for node in running if not node.children]
     said = [f"{node.name}: {node.feedback_message}" for node in leaves if node.feedback_message]
     return " ".join(parts) + (" | " + "; ".join(said) if said else "")
