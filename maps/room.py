@@ -290,6 +290,11 @@ class RoomEstimate:
         return FreeGrid(clear.reshape(grid.shape), cell, grid.origin)
 
 
+def corner_circle(side: float) -> float:
+    """The radius of the circle the dodecagon's corners lie on: ``side / (2 sin 15 deg)``."""
+    return side / (2.0 * math.sin(math.pi / CORNERS))
+
+
 def dodecagon(start: Pose2D, side: float) -> tuple[Pose2D, ...]:
     """The 12 corner poses of the room-estimation drive from ``start`` (same frame as start).
 

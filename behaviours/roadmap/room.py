@@ -43,7 +43,16 @@ from behaviours.roadmap.routine import CAMERA, ROUTINE_PORTS, Failed, RoutineBeh
 from behaviours.roadmap.values import TargetView
 from behaviours.roadmap.vision import describe
 from behaviours.telemetry import Drawing, Figure
-from maps.room import CORNERS, RigMount, RoomEstimate, RoomEstimateError, RoomParams, StereoView, estimate_room
+from maps.room import (
+    CORNERS,
+    RigMount,
+    RoomEstimate,
+    RoomEstimateError,
+    RoomParams,
+    StereoView,
+    corner_circle,
+    estimate_room,
+)
 from perception.frame import Frame
 from perception.stereo import dense_depth, dense_points, sparse_stereo
 
@@ -107,7 +116,7 @@ class RoomEstimationDodecagon(RoutineBehaviour):
     def room_needed(self) -> str:
         """What the dodecagon needs round the start, for a failure to say (a user starts the robot)."""
         side = self.get_input(self.SIDE)
-        circle = side / (2.0 * math.sin(math.pi / CORNERS))  # the corners' circle (maps.room.dodecagon)
+        circle = corner_circle(side)
         disc = robot_radius(self, 0.0)
         return (f"the dodecagon (side {side:.2f} m) needs a free disc {2.0 * (circle + disc):.2f} m across, its "
                 f"centre {circle:.2f} m to the robot's left at the start (corners on a {circle:.2f} m circle, the "

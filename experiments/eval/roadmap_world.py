@@ -59,7 +59,7 @@ from drivers.sim.cameras import camera_pose
 from drivers.sim.floor import FloorGrid, reachable_floor
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, load_world, shipped_worlds
-from maps.room import CORNERS
+from maps.room import corner_circle
 from missions.cli import main
 from perception.geometry import Pose2D, wrap_angle, wrap_angles
 
@@ -342,7 +342,7 @@ def learn_start(world: World, grid: FloorGrid, side: float = RoomEstimationDodec
     robot in a room (the paper's); a world may start it in a hallway (``flat``: 1.4 m wide, where
     the learning was stopped at its fourth corner), and a user would carry it into a room. ValueError
     when no reachable place has the room."""
-    circle = side / (2.0 * math.sin(math.pi / CORNERS))
+    circle = corner_circle(side)
     scene = Scene(world)
 
     def centre(x: float, y: float, theta: float) -> tuple[float, float]:
