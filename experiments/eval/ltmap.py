@@ -76,10 +76,12 @@ from experiments.eval.ltmap_table import estimate_shares, memory_limits, row_fig
 from experiments.eval.ltmap_table import format_table as format_table  # the area's table (experiments.eval)
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
+from experiments.sweep.episode import start_argument
 from experiments.sweep.table import read_report
 from maps.ltmap.file import load_ltmap
 from maps.ltmap.prune import DEFAULT_MIN_LANDMARKS
 from maps.ltmap.tree import LandmarkTree
+from perception.geometry import Pose2D
 
 DESCRIPTION = "teach and repeat: viewframe and path error, goal reached per LT-map tree height (Table I)"
 OPTIONS = {
@@ -249,7 +251,7 @@ def follow_episode(teach: Episode, report: Mapping[str, Any], level: Level, min_
     """The repeat of ``teach``'s map cut by ``level.cut`` levels, from the teach's true end pose, in
     ``world`` (default: the teach's)."""
     end = report["ground_truth"]["final_pose"]
-    start = f"{end['x']:.4f},{end['y']:.4f},{math.degrees(end['theta']):.3f}deg"
+    start = start_argument(Pose2D(end["x"], end["y"], end["theta"]))
     inputs: dict[str, Any] = {"map": teach.inputs["map"], "camera": teach.inputs["camera"], "direction": "reverse",
                               "min_landmarks": min_landmarks}
     if level.cut:

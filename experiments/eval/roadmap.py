@@ -84,7 +84,7 @@ from experiments.eval.roadmap_world import (
 )
 from experiments.eval.trajectory import TrueTrajectory
 from experiments.sweep import Episode, run_sweep
-from experiments.sweep.episode import SweepInputError, absolute_if_file
+from experiments.sweep.episode import SweepInputError, absolute_if_file, start_argument
 from experiments.sweep.table import read_report
 from perception.geometry import Pose2D
 
@@ -247,7 +247,7 @@ def learn_episode(world: str, seed: int, folder: Path, max_time_s: float | None,
     :func:`~experiments.eval.roadmap_world.learn_start` says where the room estimation fits)."""
     here = seed_folder(folder, world, seed)
     inputs = {"targets": str(here / "targets"), "roadmap": str(here / f"{Path(world).stem}.roadmap")}
-    where = None if start is None else f"{start.x:.4f},{start.y:.4f},{math.degrees(start.theta):.3f}deg"
+    where = None if start is None else start_argument(start)
     return Episode(LEARN, world, seed, inputs, max_time_s, where)
 
 
@@ -261,7 +261,7 @@ def goto_plans(learn: Episode, world: World, found: Sequence[str], starts: int,
     goals = [found[int(i)] for i in rng.integers(len(found), size=starts)] if found else []
     plans = []
     for k, (start, goal) in enumerate(zip(poses, goals, strict=True)):
-        where = f"{start.x:.4f},{start.y:.4f},{math.degrees(start.theta):.3f}deg"
+        where = start_argument(start)
         inputs = {"roadmap": learn.inputs["roadmap"], "target": goal, "seed": k}
         plans.append(GotoPlan(Episode(GOTO, run_in or learn.world, learn.seed, inputs, max_time_s, where), start, goal))
     return plans

@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 import os
 import re
 from collections.abc import Iterable, Mapping, Sequence
@@ -21,6 +22,7 @@ from typing import Any
 import yaml
 
 from maps.located import describe_value
+from perception.geometry import Pose2D
 
 MAX_EPISODES = 100_000
 """The largest grid a sweep accepts (a typo like ``--seeds 0-9999999`` is an input error)."""
@@ -33,6 +35,11 @@ _UNSAFE = re.compile(r"[^A-Za-z0-9.+=-]+")
 
 class SweepInputError(ValueError):
     """Invalid sweep input; ``str(exc)`` is the one-line message for the user."""
+
+
+def start_argument(pose: Pose2D) -> str:
+    """An episode's ``start`` for a pose: ``x,y,theta`` with x, y in m to 0.1 mm and theta in degrees."""
+    return f"{pose.x:.4f},{pose.y:.4f},{math.degrees(pose.theta):.3f}deg"
 
 
 @dataclass(frozen=True)
