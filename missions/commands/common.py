@@ -86,6 +86,9 @@ def parse_pose(text: str, named: dict[str, Pose2D], *, option: str) -> Pose2D:
         raise ValueError(f"{option}: numbers expected in x,y,theta, got {text!r}") from None
     if not all(math.isfinite(v) for v in (x, y, theta)):
         raise ValueError(f"{option}: finite numbers expected, got {text!r}")
+    if len(parts) == 3 and not parts[2].lower().endswith("deg") and abs(theta) > 2.0 * math.pi:
+        raise ValueError(f"{option}: theta {parts[2]} rad is more than a full turn; degrees take a deg suffix "
+                         f"({parts[0]},{parts[1]},{parts[2]}deg), got {text!r}")
     if max(abs(x), abs(y)) > MAX_COORD:
         raise ValueError(f"{option}: x and y must be within {MAX_COORD:g} m (the extent of any world), got {text!r}")
     return Pose2D(x, y, theta)

@@ -191,6 +191,8 @@ def test_a_simulated_run_starts_where_told_and_only_in_free_space(tmp_path, caps
     assert first[1:3] == pytest.approx([4.2, 3.2]) and first[3] == pytest.approx(1.5708, abs=1e-4)
     for start, expected in (("0.1,0.1,0", "--start: the pose (0.1, 0.1) is not in free space"),
                             ("nowhere", "--start must be x,y,theta or a named pose"),
-                            ("1e9,0", "--start: x and y must be within 10000 m")):
+                            ("1e9,0", "--start: x and y must be within 10000 m"),
+                            ("4.2,3.2,-93.6", "theta -93.6 rad is more than a full turn; degrees take a deg suffix "
+                                              "(4.2,3.2,-93.6deg)")):
         assert main(["run", "square", "--sim", "lab", f"--start={start}", "--quiet"]) == 2
         assert expected in capsys.readouterr().err, start
