@@ -129,7 +129,7 @@ class Simulation:
         self.rng = np.random.default_rng(seed)  # wheel slip
         streams = np.random.SeedSequence([seed, 0xBEA], pool_size=4).spawn(1 + len(self.world.cameras))
         self.scene = Scene(self.world)
-        self.crowd = Crowd(self.world.people)
+        self.crowd = Crowd(self.world.people, room=self.scene.clearance)
         self.time = 0.0
         self.last_command = 0.0  # when the base last heard a drive command (the watchdog's clock)
         self.stalled = False

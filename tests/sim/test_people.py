@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from drivers.sim.people import PERSONAL_SPACE_M, position_at
+from drivers.sim.people import PASSING_M, PERSONAL_SPACE_M, SIDESTEP_M, position_at
 from drivers.sim.scene import free_space_problem
 from drivers.sim.world import load_world
 from drivers.sim.world_values import Person, TextureSpec
@@ -56,17 +56,52 @@ def test_a_person_of_one_point_stands_still():
     assert position_at(person([[1.5, -2.0]]), 123.4) == (1.5, -2.0)
 
 
-def test_a_walking_person_waits_for_the_robot_then_walks_on(sim_from):
-    sim = sim_from(HALL.replace("theta_deg: 0", "theta_deg: 90") + "people: [{path: [[3, 0], [-3, 0]], speed: 1.0}]\n")
-    for _ in range(40):  # 4 s: the person would be at x = -1, through the robot
+def test_a_walking_person_steps_aside_round_the_robot_and_back_onto_their_path(sim_from):
+    # the robot (radius 0.25) stands on the path of a person (radius 0.25) walking from x = 3 to x = -3
+    sim = sim_from(HALL + "people: [{path: [[3, 0], [-3, 0]], speed: 1.0, wait_s: 10}]\n")
+    nearest, aside = math.inf, 0.0
+    for step in range(150):  # 15 s: 6 m at 1 m/s, the wait and the time stepping aside
         sim.step(0.1)
-    x = sim.people_xy()[0, 0]
-    assert 0.25 + 0.25 + PERSONAL_SPACE_M - 1e-9 <= x <= 0.25 + 0.25 + PERSONAL_SPACE_M + 0.1  # stopped in front
-    drive_for(sim, 0.5, 0.0, 3.0)  # the robot drives out of the way (+y)
-    assert sim.people_xy()[0, 0] < -0.5  # walked on, past where the robot stood
+        x, y = sim.people_xy()[0]
+        nearest, aside = min(nearest, math.hypot(x, y)), max(aside, abs(y))
+        if step == 69:  # 7 s: in front of the robot since 2.4 s, waiting YIELD_S for it to move
+            assert x == pytest.approx(0.25 + 0.25 + PERSONAL_SPACE_M, abs=0.1) and y == 0.0
+    assert nearest >= 0.25 + 0.25 + PASSING_M - 1e-9  # passed, never nearer the robot's disc than PASSING_M
+    assert 0.25 + 0.25 + PASSING_M - 0.1 <= aside <= SIDESTEP_M  # as far aside as passing took (one step's slack)
+    x, y = sim.people_xy()[0]
+    assert (x, y) == (-3.0, 0.0)  # walked on past the robot, back on their path to its end
+    assert sim.ground_truth_report()["collisions"] == 0
+
+
+def test_a_person_waits_behind_a_robot_that_moves_on(sim_from):
+    # the robot backs away along the person's path at 0.1 m/s: they follow at its pace, on their path
+    sim = sim_from(HALL + "people: [{path: [[3, 0], [-3, 0]], speed: 1.0}]\n")
+    for _ in range(30):  # 3 s: they reached the robot at 2.4 s
+        sim.step(0.1)
+    drive_for(sim, -0.1, 0.0, 12.0)  # longer than YIELD_S and PATIENCE_S: a moving robot is waited for
+    x, y = sim.people_xy()[0]
+    assert y == 0.0 and x == pytest.approx(-1.2 + 0.25 + 0.25 + PERSONAL_SPACE_M, abs=0.15)  # behind it, not round
+    assert sim.ground_truth_report()["collisions"] == 0
+
+
+def test_with_no_room_to_pass_a_person_waits_then_turns_back(sim_from):
+    # a 1.2 m corridor: passing a robot of radius 0.25 would take the person's centre to |y| >= 0.55,
+    # their side to 0.8, through the wall at 0.6; they wait 0.1 m from its disc, aside as far as they can,
+    # then go back
+    corridor = HALL.replace("walls: [{points: [[-4, -3], [6, -3], [6, 3], [-4, 3]], closed: true, height: 2.5}]",
+                            "walls: [{points: [[-4, -0.6], [6, -0.6]], height: 2.5}, {points: [[-4, 0.6], [6, 0.6]], "
+                            "height: 2.5}]")
+    sim = sim_from(corridor + "people: [{path: [[3, 0], [-3, 0]], speed: 1.0}]\n")
+    for _ in range(90):  # 9 s: they reached the robot at 2.4 s, waited YIELD_S, have stepped aside since 7.4 s
+        sim.step(0.1)
+    x, y = sim.people_xy()[0]
+    assert 0.25 + 0.25 + PERSONAL_SPACE_M - 1e-9 <= x <= 0.25 + 0.25 + PERSONAL_SPACE_M + 0.1
+    assert 0.0 < abs(y) <= 0.6 - 0.25  # stood aside as far as the wall lets them
+    for _ in range(70):  # 16 s: held PATIENCE_S in all by about 12.8 s, walking back since
+        sim.step(0.1)
+    assert sim.people_xy()[0, 0] > x + 1.0
     report = sim.ground_truth_report()
-    assert report["collisions"] == 0
-    assert report["min_clearance_m"] >= PERSONAL_SPACE_M - 1e-9  # nobody walked into the robot
+    assert report["collisions"] == 0 and report["min_clearance_m"] >= PERSONAL_SPACE_M - 1e-9
 
 
 def test_driving_into_a_standing_person_is_a_collision_with_a_person(sim_from):
