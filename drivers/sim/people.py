@@ -112,7 +112,7 @@ class Crowd:
 
     def step(self, dt: float, robot_xy: Sequence[float] | np.ndarray, robot_radius: float) -> None:
         """Advance every person by ``dt`` seconds: walk on, step aside, wait or turn back (module docstring)."""
-        robot = np.asarray(robot_xy, dtype=float)
+        robot = np.array(robot_xy, dtype=float)  # a copy: kept as where the robot was, for the next step
         still = self._robot is not None and float(np.hypot(*(robot - self._robot))) <= STILL_M_S * dt
         for i, person in enumerate(self.people):
             if len(person.path) == 1:
