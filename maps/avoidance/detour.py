@@ -19,7 +19,13 @@ the robot's odometry. Three phases:
   wish passes; ``clear_time`` of that ends the detour, and the motion node steers back to its
   path by itself. A wish to stop or to back away passes (the collision monitor judges it). Where
   the wish heads is kept in the odometry frame from its last forward command, so that a wish to
-  turn on the spot (which says only which way) does not swing the choice as the robot turns. So
+  turn on the spot (which says only which way) does not swing the choice as the robot turns. A
+  hold whose wish was a turn on the spot when first judged (the node means to face something
+  beyond the fan's edge: a new goal behind the robot) takes no direction more than
+  :data:`FACING` from that edge, and with none backs away (below): driving on the other way takes
+  the robot away from where it turns to (in `flat`'s exploration the monitor stopped the robot at
+  the mouth of a slot between a bed and a wall as a goal 13 m behind it was chosen; the only free
+  direction was straight on, and the detour drove 1 m into the slot, where the robot stayed). So
   a wish to turn on the spot towards a goal (``reach``) nearer than anything sensed (every point
   farther from the robot's centre than the goal and the footprint's farthest corner together)
   ends the detour at once: the detour took the robot beside its goal (past a person, to a
@@ -80,6 +86,7 @@ BACKOFFS_PER_HOLD = 2  # back-offs in one hold (the hold goes on where the robot
 RESTART_GAP = 2.0  # s: a hold cut short by the node's ending goes on when held again this soon ...
 STOOD = 0.05  # m: ... this close to where it was held
 PROGRESS = 0.1  # m: a detour that has not moved this far from where it was for ``timeout`` s got nowhere
+FACING = math.pi / 2.0  # rad: a hold whose wish is a turn on the spot takes no direction farther than this from it
 
 
 @dataclass(frozen=True, slots=True)
@@ -145,6 +152,7 @@ class _Episode:
     backed: float = 0.0  # m backed in the current back-off
     beyond: float = 0.0  # m a direction must be free for after a back-off: past where the robot was wedged
     anchor: tuple[float, Pose2D] | None = None  # (since, where): the detour has not moved PROGRESS from there since
+    facing: bool = False  # the wish was a turn on the spot when first judged: the node faces beyond the fan's edge
 
 
 class Avoidance:
@@ -243,7 +251,7 @@ class Avoidance:
         if held < self.settings.wait:
             return Decision(0.0, 0.0, "waiting")
         choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode), pose=pose,
-                        line=episode.line, side=self._other_side(pose, now))
+                        line=episode.line, side=self._other_side(pose, now), within=self._within(episode))
         if choice.direction is not None:
             self._end_wait(episode, now, cleared=False)
             episode.detour_start, episode.last, episode.side = now, pose, choice.side
@@ -280,7 +288,7 @@ class Avoidance:
             return Decision(v, w, "detour", passed=True)
         episode.clear_since = None
         choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode),
-                        side=episode.side, pose=pose, line=episode.line)
+                        side=episode.side, pose=pose, line=episode.line, within=self._within(episode))
         command = steer(choice, around, self.avoid)
         if choice.direction is not None and not stopped and command != (0.0, 0.0):
             episode.held_since = None
@@ -475,7 +483,15 @@ class Avoidance:
         not swing as the robot turns."""
         if v > 0.0 or episode.goal is None:
             episode.goal = pose.theta + wished_direction(v, w, self.avoid)
+            episode.facing = v <= 0.0
         return float(np.clip(wrap_angle(episode.goal - pose.theta), -self.avoid.spread, self.avoid.spread))
+
+    @staticmethod
+    def _within(episode: _Episode) -> float:
+        """How far from the wish a direction may be (rad): :data:`FACING` while the wish stands for a
+        turn on the spot (the node means to face beyond the fan's edge: a direction on the other side
+        of straight ahead drives away from it), any distance for a wish that drives."""
+        return FACING if episode.facing else math.inf
 
     def _reach(self, v: float, episode: _Episode | None = None) -> float:
         """How far a detour's direction must be free: as far as the detour's speed needs, or the wish's,

@@ -90,17 +90,18 @@ def wished_direction(v: float, w: float, settings: AvoidSettings) -> float:
 
 
 def choose(around: Surroundings, wish: float, settings: AvoidSettings, *, reach: float | None = None, side: int = 0,
-           pose: Pose2D | None = None, line: DetourLine | None = None) -> Choice:
+           pose: Pose2D | None = None, line: DetourLine | None = None, within: float = math.inf) -> Choice:
     """Judge the histogram against the points ``around`` the base and choose the direction for the
     ``wish`` (module docstring); ``reach`` defaults to what the detour's speed needs (eq. 1), ``side``
-    (+1 left, -1 right of the wish) is the side a detour took."""
+    (+1 left, -1 right of the wish) is the side a detour took; directions more than ``within`` (rad)
+    from the wish are not taken."""
     reach = needed_distance(settings.speed, settings) if reach is None else reach
     fan = angles(settings)
     free = around.free_towards(fan)
     directions = tuple(Direction(float(a), float(f), around.turns(float(a)),
                                  _strays(float(a), reach, settings.max_stray, pose, line))
                        for a, f in zip(fan, free, strict=True))
-    usable = [i for i, d in enumerate(directions) if d.will_do(reach)]
+    usable = [i for i, d in enumerate(directions) if d.will_do(reach) and abs(d.angle - wish) <= within]
     if not usable:
         return Choice(directions, None, wish, reach)
     step = float(fan[1] - fan[0]) if len(fan) > 1 else 1.0

@@ -153,3 +153,28 @@ def test_without_a_trail_or_with_back_offs_off_it_stays_held():
             d = a.step(0.3, 0.0, seen(here), here, float(t))
             assert (d.phase, d.v, d.w) == ("waiting", 0.0, 0.0)
         assert a.tally.backoffs == 0
+
+
+SLOT = np.array([[x, side * 0.40] for x in np.arange(-1.0, 2.01, 0.05) for side in (-1.0, 1.0)])  # walls 0.14 m off
+
+
+def test_held_while_the_wish_turns_round_it_backs_out_of_a_slot_rather_than_driving_on_into_it():
+    """In a slot (walls 0.14 m beside the disc, open ahead), the monitor stops the robot and the node
+    then wishes to turn round (a new goal behind it). Straight ahead is the only free direction, but
+    120 degrees from the turn's edge: driving on takes the robot away from where it turns to (in
+    `flat`'s exploration it drove 1 m on between a bed and a wall, never to get out). It backs out
+    the way it came instead."""
+    a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0))
+    t = drive_in(a)
+    pose = Pose2D(0.0, 0.0, 0.0)
+    assert a.step(0.2, 0.0, SLOT, pose, t, stopped=True).phase == "waiting"
+    for now in np.arange(t + 0.1, t + 2.0, 0.1):
+        assert a.step(0.0, 0.5, SLOT, pose, float(now)).phase == "waiting"
+    d = a.step(0.0, 0.5, SLOT, pose, t + 2.0)
+    assert d.phase == "backoff" and d.v < 0.0 and a.tally.detours == 0
+    # a wish that drives (the node faces where it goes) may take any free direction again
+    b = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0))
+    t = drive_in(b)
+    b.step(0.2, 0.0, SLOT, pose, t, stopped=True)
+    ahead = b.step(0.2, 0.0, SLOT, pose, t + 2.0)
+    assert ahead.phase == "detour" and ahead.v > 0.0
