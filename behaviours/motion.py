@@ -5,6 +5,12 @@ Each behaviour writes a :class:`~drivers.interfaces.VelocityCommand` to its ``co
 each tick, so a finished or halted behaviour leaves the robot commanded to rest. Speeds ramp
 down as ``sqrt(2 a d)`` near the end so the base stops on target within its deceleration limit
 instead of overshooting.
+
+A motion the collision monitor keeps stopping (a person standing in the way, a wall short of the
+goal) fails after ``held_timeout`` seconds with the monitor's reason, as Nav2's ``DriveOnHeading``
+fails past its ``time_allowance``: otherwise a ``Drive`` at someone who stays would hold the
+mission until its time limit, and no recovery could take over. Wrap it in ``AvoidObstacles`` to
+wait for them and drive round.
 """
 
 from __future__ import annotations
@@ -17,7 +23,9 @@ from py_trees.common import Status
 from behaviours.base import BearingsBehaviour
 from behaviours.ports import InputPort, OutputPort, Port, Ref
 from behaviours.registry import register
+from behaviours.keys import SAFETY_KEY
 from drivers.interfaces import STOP, VelocityCommand
+from perception.collision_monitor import SafetyState
 from perception.geometry import Pose2D, wrap_angle
 
 LINEAR_DECEL = 0.25  # m/s^2, below the Pioneer's 0.3 so the ramp is always achievable
@@ -37,7 +45,10 @@ ODOMETRY = InputPort("odometry", Pose2D, Ref("/robot/odometry"), doc="the base's
 STALLED = InputPort("stalled", bool, Ref("/robot/stalled"), doc="a wheel is stalled: stop and fail")
 COMMAND = OutputPort("command", VelocityCommand, "/robot/command", unit="m/s, rad/s",
                      doc="the velocity for this tick (the runner sends it to the base)")
-MOTION_PORTS: tuple[Port, ...] = (ODOMETRY, STALLED, COMMAND)
+SAFETY = InputPort("safety", SafetyState, Ref(SAFETY_KEY.path), doc=SAFETY_KEY.doc)
+HELD_TIMEOUT = InputPort("held_timeout", float, 20.0, unit="s", minimum=0.0, maximum=3600.0, literal_only=True,
+                         doc="fail when the collision monitor has stopped the motion this long (0: never)")
+MOTION_PORTS: tuple[Port, ...] = (ODOMETRY, STALLED, COMMAND, SAFETY, HELD_TIMEOUT)
 
 
 class OdometryMotion(BearingsBehaviour):
@@ -45,6 +56,7 @@ class OdometryMotion(BearingsBehaviour):
     it ends or is halted; subclasses implement :meth:`step` (plugins may subclass it too)."""
 
     PORTS: ClassVar[tuple[Port, ...]] = MOTION_PORTS
+    _held_since: float | None = None  # the collision monitor has stopped every command since
 
     def odometry(self) -> Pose2D | None:
         return self.get_input(ODOMETRY, None)
@@ -60,12 +72,27 @@ class OdometryMotion(BearingsBehaviour):
             return True
         return False
 
+    def held(self) -> bool:
+        """Has the collision monitor stopped this motion's commands for ``held_timeout`` seconds? Then
+        it is stopped, with the monitor's reason."""
+        safety, limit = self.get_input(SAFETY, None), self.get_input(HELD_TIMEOUT)
+        if not isinstance(safety, SafetyState) or safety.state != "stopped" or limit <= 0.0:
+            self._held_since = None
+            return False
+        now = self.now()
+        self._held_since = now if self._held_since is None else self._held_since
+        if now - self._held_since < limit:
+            return False
+        self.command(0.0, 0.0)
+        self.feedback_message = f"held by the collision monitor for {now - self._held_since:.0f} s: {safety.reason}"
+        return True
+
     def update(self) -> Status:
         pose = self.odometry()
         if pose is None:
             self.feedback_message = "waiting for odometry"
             return Status.RUNNING
-        if self.blocked():
+        if self.blocked() or self.held():
             return Status.FAILURE
         return self.step(pose)
 
@@ -76,6 +103,7 @@ class OdometryMotion(BearingsBehaviour):
     def terminate(self, new_status: Status) -> None:
         if new_status != Status.RUNNING:
             self.set_output(COMMAND, STOP)
+            self._held_since = None
 
 
 @register

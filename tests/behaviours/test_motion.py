@@ -11,6 +11,7 @@ from behaviours.motion import Drive, DriveTo, Rotate, Stop
 from behaviours.testing import BehaviourHarness
 from behaviours.wait import Wait
 from drivers.interfaces import STOP, VelocityCommand
+from perception.collision_monitor import SafetyState
 from perception.geometry import Pose2D
 
 
@@ -52,6 +53,29 @@ def test_drive_waits_for_odometry_then_fails_when_stalled():
     assert harness.tick() == Status.FAILURE
     assert harness.behaviour.feedback_message == "stalled"
     assert harness.read("/robot/command") == STOP
+
+
+def test_a_drive_the_collision_monitor_keeps_stopping_fails_after_the_held_timeout_with_its_reason():
+    stop = SafetyState("stopped", "stop", "front", "obstacle 0.08 m from the footprint in the stop zone 'front'")
+    harness = BehaviourHarness(Drive(distance=5.0, held_timeout=10.0),
+                               blackboard={"/robot/odometry": Pose2D(), "/robot/safety": stop})
+    assert harness.tick() == Status.RUNNING  # held since now
+    harness.clock.advance(9.9)
+    assert harness.tick() == Status.RUNNING and harness.read("/robot/command").v > 0.0  # it asks on
+    harness.write("/robot/safety", SafetyState())  # the way cleared for a tick: the clock starts again
+    harness.clock.advance(0.1)
+    assert harness.tick() == Status.RUNNING
+    harness.write("/robot/safety", stop)
+    harness.tick()
+    harness.clock.advance(10.0)
+    assert harness.tick() == Status.FAILURE and harness.read("/robot/command") == STOP
+    assert harness.behaviour.feedback_message == (
+        "held by the collision monitor for 10 s: obstacle 0.08 m from the footprint in the stop zone 'front'")
+    never = BehaviourHarness(Drive(distance=5.0, held_timeout=0.0),
+                             blackboard={"/robot/odometry": Pose2D(), "/robot/safety": stop})
+    never.tick()
+    never.clock.advance(1000.0)
+    assert never.tick() == Status.RUNNING  # 0: held for ever, as before
 
 
 def test_drive_slows_down_before_the_goal():

@@ -1,7 +1,8 @@
 """A mission driving straight at a person, in the simulator with its own sonar ring and bumpers.
 
 ``Drive: {distance: 5}`` at a person standing 2 m ahead: the collision monitor stops the base short
-of them and the report says so (the monitor's events, no collision). ``AvoidObstacles`` around the
+of them and the report says so (the monitor's events, no collision); the drive fails once held for
+its ``held_timeout``. ``AvoidObstacles`` around the
 same ``Drive``: it waits for a person who walks across and passes (and the drive then gets its 5 m),
 and it gives up with a reason when the person stays (the mission's recovery would take over).
 """
@@ -38,8 +39,10 @@ def run(sim_from, tmp_path, world: str, tree: str, max_time: float):
 
 
 def test_driving_at_a_person_stops_short_of_them_with_the_monitors_event_in_the_report(sim_from, tmp_path):
-    result, sim = run(sim_from, tmp_path, HALL + STANDING, "  Drive: {distance: 5.0}\n", 20.0)
-    assert result.status == "FAILURE" and "time limit" in result.reason  # Drive never gets its 5 m
+    result, sim = run(sim_from, tmp_path, HALL + STANDING, "  Drive: {distance: 5.0, held_timeout: 10}\n", 30.0)
+    # Drive never gets its 5 m: held by the monitor, it fails after its held_timeout with the monitor's reason
+    assert result.status == "FAILURE" and "held by the collision monitor for 10 s: obstacle" in result.reason
+    assert result.time_s < 20.0, result.time_s  # held from about 5 s on, not the 30 s time limit
     truth, safety = result.report["ground_truth"], result.report["safety"]
     assert truth["collisions"] == 0 and truth["collisions_with_people"] == 0
     gap = 2.0 - 0.25 - sim.true_pose().x - sim.world.robot_radius  # between the robot's disc and the person's
