@@ -13,11 +13,18 @@ disparities) and may be looking sideways:
 - **Path ahead**: the path's next ``check_distance`` metres must keep the robot's disc clear of
   obstacle cells in the current map; otherwise it is planned again from here
   (:func:`maps.exploration.travel.travel_cost`), and FAILURE when the target cannot be reached any more.
+  Where the path runs on the robot's own trail, only obstacle cells on the trail itself block it
+  (:func:`maps.exploration.queries.blocking_cells`): it fitted there, as the travel cost says too;
+  in `flat` a robot in a slot its map had since narrowed gave up every goal for 690 s.
 - **Motion**: the speed lets the base stop (within its deceleration) before the arc it is driving
   brings an obstacle cell within ``robot_radius + clearance`` of its centre, nearer than now
   (:func:`maps.exploration.queries.free_travel`). Pure pursuit cuts corners, and a stop commanded at once still coasts a
   quarter of a metre at 0.4 m/s (0.3 m/s^2): in one simulated run the robot swung round a table's
-  corner on a path planned clear of it and touched it while coasting.
+  corner on a path planned clear of it and touched it while coasting. Where that stops the robot,
+  it steers to the path point ``CLOSE_LOOKAHEAD`` away instead (turning on the spot to it when
+  that is farther off than ``turn_in_place``): it follows the path itself where cutting its corner
+  would come too near something (in `flat` the robot stood beside a dining table, the carrot 30
+  degrees off, the arc to it closing on the table's edge, until each goal was given up).
 - **Seen floor ahead only**: the robot does not drive *into* floor it has not seen: it brakes to
   ``crawl`` ``unseen_margin`` before the first point of the path ahead where the front of its disc
   (within ``front`` of the direction of travel) covers an unknown cell (beyond the disc it covers
@@ -69,6 +76,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -85,10 +93,26 @@ from behaviours.telemetry import Drawing, Figure, Lines
 from drivers.interfaces import STOP, VelocityCommand
 from maps.exploration.goal import Goal
 from maps.exploration.grid import Cell, ExplorationMap
-from maps.exploration.queries import blocking_cells, cells_around, disc_cells, free_travel, moved_onto
+from maps.exploration.queries import blocking_cells, cells_around, free_travel, moved_onto
 from maps.exploration.travel import travel_cost
 from perception.geometry import Pose2D, wrap_angle
 from perception.ranges import RangeScan
+
+CLOSE_LOOKAHEAD = 0.1  # m: the carrot when the one ``lookahead`` away cuts a corner too near something
+
+
+@dataclass(frozen=True, slots=True)
+class _Step:
+    """One tick's command towards a carrot: ``error`` its bearing off the heading (rad); ``turning`` on
+    the spot first; ``blind``: stopped short of unseen floor; ``held_by_map``: stopped by an obstacle
+    cell the arc would bring within the room."""
+
+    v: float
+    w: float
+    error: float
+    turning: bool = False
+    blind: bool = False
+    held_by_map: bool = False
 
 
 def approach_speed(gap: float, approach: float, decel: float, reaction: float, clearance: float) -> float:
@@ -246,30 +270,42 @@ class FollowPath(BearingsBehaviour):
             self.command(0.0, 0.0)
             self.feedback_message = f"no progress for {self.get_input(self.STUCK_TIME):g} s: giving the goal up"
             return Status.FAILURE
+        seen = self._seen_distance(m, here)
+        step = self._towards(pose, m, carrot, remaining, seen)
+        if step.held_by_map:  # the chord to the carrot cuts a corner too near something: follow the path itself
+            near, _ = self._carrot(here, CLOSE_LOOKAHEAD)
+            close = self._towards(pose, m, near, remaining, seen)
+            step = close if close.turning or close.v > step.v else step
+        if step.turning:
+            self.command(0.0, step.w)
+            self.feedback_message = f"turning towards the path ({math.degrees(step.error):+.0f} deg)"
+            return Status.RUNNING
+        self.blind_stops += int(step.blind)
+        self.safety_stops += int(step.held_by_map)
+        self.command(step.v, step.w)
+        self.feedback_message = f"{remaining:.2f} m to go" + ("" if math.isinf(seen) else f", {seen:.2f} m seen")
+        return Status.RUNNING
+
+    def _towards(self, pose: Pose2D, m: ExplorationMap, carrot: np.ndarray, remaining: float, seen: float) -> _Step:
+        """The command that steers to ``carrot``: a turn on the spot beyond ``turn_in_place``, else a
+        drive capped by the path left, the speed limit, the unseen floor ahead, the lane's echoes and
+        the map (the base stops before the arc brings an obstacle cell within the room)."""
         error = wrap_angle(math.atan2(carrot[1] - pose.y, carrot[0] - pose.x) - pose.theta)
         top_w = math.radians(self.get_input(self.TURN_RATE))
         w = ramp(error, top_w, ANGULAR_DECEL, 0.0) if error else 0.0
-        seen = self._seen_distance(m, here)
         if abs(error) > math.radians(self.get_input(self.TURN_IN_PLACE)):
-            self.command(0.0, w)
-            self.feedback_message = f"turning towards the path ({math.degrees(error):+.0f} deg)"
-            return Status.RUNNING
+            return _Step(0.0, w, error, turning=True)
         see = self.get_input(self.UNSEEN_MARGIN)  # brake to a crawl where the cameras can still see it
         crawl = self.get_input(self.CRAWL) if seen > m.frame.resolution else 0.0
         blind = max(math.sqrt(2.0 * LINEAR_DECEL * max(seen - see, 0.0)), crawl)
         v = min(ramp(remaining, self.get_input(self.SPEED), LINEAR_DECEL, 0.02),
                 self.get_input(self.SPEED_LIMIT, math.inf), blind)
         v = max(0.0, min(v, self._lane_speed()) * math.cos(error))
-        self.blind_stops += int(blind < 0.02)
         room = disc_radius(self) + self.get_input(CLEARANCE)
         reach = self.get_input(self.SPEED) ** 2 / (2.0 * LINEAR_DECEL) + 0.1
         free = free_travel(m, pose, w / max(v, 0.05), room, reach)
         v = min(v, math.sqrt(2.0 * LINEAR_DECEL * max(free - m.frame.resolution, 0.0)))  # stops in time
-        if free < reach:
-            self.safety_stops += int(v < 0.02)
-        self.command(v, w)
-        self.feedback_message = f"{remaining:.2f} m to go" + ("" if math.isinf(seen) else f", {seen:.2f} m seen")
-        return Status.RUNNING
+        return _Step(v, w, error, blind=blind < 0.02, held_by_map=free < reach and v < 0.02)
 
     def _lane_speed(self) -> float:
         """The speed cap of the echoes straight ahead (eq. A; inf without range sensors or such echoes):
@@ -291,12 +327,14 @@ class FollowPath(BearingsBehaviour):
         window = self.path[self.index : self.index + 40]
         return self.index + int(np.argmin(np.hypot(*(window - here).T)))
 
-    def _carrot(self, here: np.ndarray) -> tuple[np.ndarray, float]:
-        """The first path point ``lookahead`` away from the robot, and the path length left."""
+    def _carrot(self, here: np.ndarray, lookahead: float | None = None) -> tuple[np.ndarray, float]:
+        """The first path point ``lookahead`` (default: the input's) away from the robot, and the path
+        length left."""
         ahead = self.path[self.index :]
         steps = np.hypot(*np.diff(ahead, axis=0).T) if len(ahead) > 1 else np.zeros(0)
         remaining = float(steps.sum()) + float(np.hypot(*(ahead[0] - here)))
-        far = np.flatnonzero(np.hypot(*(ahead - here).T) >= self.get_input(self.LOOKAHEAD))
+        lookahead = self.get_input(self.LOOKAHEAD) if lookahead is None else lookahead
+        far = np.flatnonzero(np.hypot(*(ahead - here).T) >= lookahead)
         return (ahead[far[0]] if len(far) else ahead[-1]), remaining
 
     def _ahead(self, ahead: np.ndarray) -> np.ndarray:
@@ -305,16 +343,15 @@ class FollowPath(BearingsBehaviour):
         return ahead[along <= self.get_input(self.CHECK_DISTANCE)]
 
     def _blocked(self, m: ExplorationMap, ahead: np.ndarray) -> bool:
-        """Does the path ``ahead``'s first ``check_distance`` bring the disc onto an obstacle cell?"""
-        if len(ahead) == 0:
-            return False
-        return bool(np.any(disc_cells(m, self._ahead(ahead), disc_radius(self)) == Cell.OBSTACLE))
+        """Does the path ``ahead``'s first ``check_distance`` bring the disc onto an obstacle cell (beside
+        the robot's trail, only one on the trail itself: :func:`maps.exploration.queries.blocking_cells`)?"""
+        return len(ahead) > 0 and len(blocking_cells(m, self._ahead(ahead), disc_radius(self), trail=True)) > 0
 
     def _moved_onto(self, m: ExplorationMap) -> bool:
         """Was every obstacle cell that blocks the path ahead free floor on the last map on which the
         way was clear (something moved onto it), rather than unknown or an obstacle then?"""
         return self.clear_map is not None and moved_onto(
-            self.clear_map, blocking_cells(m, self._ahead(self.path[self.index:]), disc_radius(self)))
+            self.clear_map, blocking_cells(m, self._ahead(self.path[self.index:]), disc_radius(self), trail=True))
 
     def _wait(self) -> Status:
         """Stopped for something that moved onto the path: RUNNING for ``wait`` seconds, then FAILURE."""

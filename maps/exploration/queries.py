@@ -54,12 +54,32 @@ def disc_cells(m: ExplorationMap, centres: np.ndarray, radius: float) -> np.ndar
     return states[distance <= radius]
 
 
-def blocking_cells(m: ExplorationMap, path: np.ndarray, radius: float) -> np.ndarray:
-    """The centres (K x 2) of the obstacle cells of ``m`` within ``radius`` of a point of ``path``."""
+def blocking_cells(m: ExplorationMap, path: np.ndarray, radius: float, *, trail: bool = False) -> np.ndarray:
+    """The centres (K x 2) of the obstacle cells of ``m`` within ``radius`` of a point of ``path``.
+
+    With ``trail``, a point of the path on the robot's trail (``visited``) is blocked only by obstacle
+    cells on the trail themselves (something stands where the robot drove): it fitted there, so an
+    obstacle cell beside its trail is a squeeze narrowed by stereo noise, or something the range
+    sensors judge as it drives (the travel cost's own rule, :func:`maps.exploration.travel.traversable`).
+    Without it, a robot in a place its map has since narrowed finds every way out blocked."""
     if len(path) == 0:
         return np.zeros((0, 2))
-    centres, _, distance, states = cells_around(m, path, radius)
-    return centres[(distance <= radius) & (states == Cell.OBSTACLE)]
+    points = np.asarray(path, dtype=np.float64).reshape(-1, 2)
+    centres, _, distance, states = cells_around(m, points, radius)
+    hit = (distance <= radius) & (states == Cell.OBSTACLE)
+    if trail:
+        on_trail = np.repeat(_visited(m, points), len(states) // len(points))
+        hit &= ~on_trail | _visited(m, centres)
+    return centres[hit]
+
+
+def _visited(m: ExplorationMap, xy: np.ndarray) -> np.ndarray:
+    """Whether each (x, y) lies on a cell of the robot's trail (False outside the grid)."""
+    rows, cols = m.frame.cell_of(xy)
+    inside = m.frame.inside(rows, cols)
+    out = np.zeros(len(rows), dtype=bool)
+    out[inside] = m.visited[rows[inside], cols[inside]]
+    return out
 
 
 def moved_onto(before: ExplorationMap, blocking: np.ndarray) -> bool:

@@ -125,6 +125,25 @@ def test_a_wall_across_the_path_fails_the_goal():
     assert harness.behaviour.replans == 1
 
 
+def test_a_way_back_along_its_own_trail_is_not_blocked_by_what_the_map_saw_beside_it_since():
+    """The robot drove into a slot along y = 0 (its trail); the map has since put obstacle cells 0.2 m
+    either side (stereo noise, a low bed's edge): within its 0.25 m radius. The path back out along the
+    trail is followed, not given up (in `flat` every goal was given up there for 690 s)."""
+    cells = room().cells.copy()
+    xs = FRAME.centre_of(np.zeros(FRAME.cols, dtype=int), np.arange(FRAME.cols))[:, 0]
+    ys = FRAME.centre_of(np.arange(FRAME.rows), np.zeros(FRAME.rows, dtype=int))[:, 1]
+    beside = np.abs(np.abs(ys) - 0.2) < 0.03
+    cells[np.ix_(beside, xs < 3.0)] = Cell.OBSTACLE
+    visited = np.zeros(FRAME.shape, dtype=bool)
+    visited[np.ix_(np.abs(ys) < 0.03, (xs > -0.5) & (xs < 3.0))] = True
+    m = ExplorationMap.from_cells(FRAME, cells, visited=visited)
+    harness = follow(m, goal_to(2.5))
+    assert harness.tick() == Status.RUNNING and harness.behaviour.replans == 0
+    assert harness.read("/robot/command").v > 0.0
+    blind = follow(ExplorationMap.from_cells(FRAME, cells), goal_to(2.5))  # no trail: the same cells block
+    assert blind.tick() == Status.FAILURE
+
+
 def test_waits_for_someone_who_stepped_onto_the_path_then_drives_on():
     harness = follow(room(), goal_to(3.0), wait=6.0)
     assert harness.tick() == Status.RUNNING  # the way is clear: this map is the one to compare with
@@ -201,6 +220,28 @@ def test_slows_to_stop_before_an_obstacle_the_arc_would_touch():
         pose = harness.read("/robot/odometry")
         closest = min(closest, float(np.hypot(pose.x - post[0], pose.y - post[1])))
     assert closest >= 0.35 - 0.01 and harness.behaviour.safety_stops > 0
+
+
+def test_where_cutting_the_corner_to_the_carrot_would_come_too_near_it_follows_the_path_itself():
+    """A wall 0.275 m to the right (within the 0.30 m room, outside the 0.25 m disc), the robot heading
+    25 degrees towards it, its path stepping 5 cm left and then running along the wall. The carrot
+    0.4 m on lies 32 degrees left: not enough to turn on the spot, and the arc to it closes on the wall
+    at once (held, for ever: in `flat`'s kitchen beside the dining table the robot stood so until its
+    goals were given up one after the other). The path's next point 0.1 m away lies 52 degrees left:
+    it turns towards that first, then drives along the path."""
+    path = np.vstack(([[0.0, 0.0]], np.column_stack((np.arange(0.0, 3.01, 0.05), np.full(61, 0.05)))))
+    goal = Goal(Mode.FRONTIER, (3.0, 0.05), None, 0.0, 3.0, math.nan, path)
+    harness = follow(with_obstacles(*[(x, -0.275) for x in np.arange(-0.5, 3.0, 0.05)]), goal,
+                     Pose2D(0.0, 0.0, math.radians(-25.0)), check_distance=0.0)
+    assert harness.tick() == Status.RUNNING
+    turn = harness.read("/robot/command")
+    assert turn.v == 0.0 and turn.w > 0.0 and harness.behaviour.feedback_message == "turning towards the path (+52 deg)"
+    for _ in range(40):
+        harness.tick()
+        drive(harness)
+        harness.clock.advance(0.2)
+    pose = harness.read("/robot/odometry")
+    assert pose.x > 1.0 and pose.y > -0.02  # along the path, never nearer the wall than it started
 
 
 def test_a_wall_alongside_does_not_slow_the_robot():

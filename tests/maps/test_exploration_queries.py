@@ -42,6 +42,21 @@ def test_the_cells_blocking_a_path_are_the_obstacle_cells_within_the_radius_of_i
     assert blocking_cells(floor(), np.zeros((0, 2)), 0.2).shape == (0, 2)
 
 
+def test_beside_the_trail_only_obstacle_cells_on_the_trail_block_it():
+    # the robot drove along y = 0.45 (row 4 visited); the wall column x = 1.05 lies 0.2 m from (0.85, 0.45)
+    visited = np.zeros((10, 30), dtype=bool)
+    visited[4, :10] = True  # x 0-1: up to the wall, not through it
+    m = grid_map(floor().cells, visited=visited)
+    on_trail = np.array([[0.85, 0.45]])
+    assert len(blocking_cells(m, on_trail, 0.25)) > 0  # without the trail's rule: the wall blocks
+    assert blocking_cells(m, on_trail, 0.25, trail=True).shape == (0, 2)  # it fitted there
+    off_trail = np.array([[0.85, 0.25]])  # beside the trail: judged as ever
+    assert len(blocking_cells(m, off_trail, 0.25, trail=True)) == len(blocking_cells(m, off_trail, 0.25)) > 0
+    visited[4, 10] = True  # something stands on the trail itself now (the wall cell (1.05, 0.45))
+    stands = blocking_cells(grid_map(floor().cells, visited=visited), on_trail, 0.25, trail=True)
+    assert sorted(map(tuple, np.round(stands, 3))) == [(1.05, 0.45)]
+
+
 def test_moved_onto_when_every_blocking_cell_was_free_floor_before():
     blocking = blocking_cells(floor(), np.array([[0.9, 0.5]]), 0.2)
     assert moved_onto(floor(wall=None), blocking)  # free floor then: someone stepped there
