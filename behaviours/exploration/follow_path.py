@@ -245,15 +245,16 @@ class FollowPath(BearingsBehaviour):
             self.command(0.0, 0.0)
             self.feedback_message = "at the goal"
             return Status.RUNNING
-        if self._blocked(m, self.path[self.index:]):
+        blocking = self._blocking(m, self.path[self.index:])
+        if len(blocking):
             self.replans += 1
             planned = disc_radius(self) + self.get_input(CLEARANCE)
             travel = travel_cost(m, (pose.x, pose.y), planned,
                                  margin=self.get_input(self.MARGIN), penalty=self.get_input(self.PENALTY))
             path = travel.path_to(goal.target)
-            if len(path) and not self._blocked(m, path):
+            if len(path) and not len(self._blocking(m, path)):
                 self.path, self.index, self.waiting_since = path, 0, None
-            elif self._moved_onto(m):
+            elif self.clear_map is not None and moved_onto(self.clear_map, blocking):
                 return self._wait()
             else:
                 self.command(0.0, 0.0)
@@ -342,16 +343,12 @@ class FollowPath(BearingsBehaviour):
         along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ahead, axis=0).T))))
         return ahead[along <= self.get_input(self.CHECK_DISTANCE)]
 
-    def _blocked(self, m: ExplorationMap, ahead: np.ndarray) -> bool:
-        """Does the path ``ahead``'s first ``check_distance`` bring the disc onto an obstacle cell (beside
-        the robot's trail, only one on the trail itself: :func:`maps.exploration.queries.blocking_cells`)?"""
-        return len(ahead) > 0 and len(blocking_cells(m, self._ahead(ahead), disc_radius(self), trail=True)) > 0
-
-    def _moved_onto(self, m: ExplorationMap) -> bool:
-        """Was every obstacle cell that blocks the path ahead free floor on the last map on which the
-        way was clear (something moved onto it), rather than unknown or an obstacle then?"""
-        return self.clear_map is not None and moved_onto(
-            self.clear_map, blocking_cells(m, self._ahead(self.path[self.index:]), disc_radius(self), trail=True))
+    def _blocking(self, m: ExplorationMap, ahead: np.ndarray) -> np.ndarray:
+        """The obstacle cells (K x 2) the disc covers along the path ``ahead``'s first ``check_distance``
+        (beside the robot's trail, only those on the trail itself: :func:`maps.exploration.queries.blocking_cells`).
+        Were they all free floor on the last map on which the way was clear, something moved onto it
+        (:func:`maps.exploration.queries.moved_onto`): a wait, not a give-up."""
+        return blocking_cells(m, self._ahead(ahead), disc_radius(self), trail=True) if len(ahead) else np.zeros((0, 2))
 
     def _wait(self) -> Status:
         """Stopped for something that moved onto the path: RUNNING for ``wait`` seconds, then FAILURE."""
