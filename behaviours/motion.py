@@ -21,9 +21,9 @@ from typing import ClassVar
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
+from behaviours.keys import SAFETY_KEY
 from behaviours.ports import InputPort, OutputPort, Port, Ref
 from behaviours.registry import register
-from behaviours.keys import SAFETY_KEY
 from drivers.interfaces import STOP, VelocityCommand
 from perception.collision_monitor import SafetyState
 from perception.geometry import Pose2D, wrap_angle

@@ -78,7 +78,8 @@ def _visited(m: ExplorationMap, xy: np.ndarray) -> np.ndarray:
     rows, cols = m.frame.cell_of(xy)
     inside = m.frame.inside(rows, cols)
     out = np.zeros(len(rows), dtype=bool)
-    out[inside] = m.visited[rows[inside], cols[inside]]
+    if m.visited is not None:  # always set once the map is built (None only as a constructor argument)
+        out[inside] = m.visited[rows[inside], cols[inside]]
     return out
 
 
