@@ -37,7 +37,7 @@ def test_unknown_parameter(write_mission):
     """)
     found = problems(path)
     assert (2, "Drive has no port 'distanse'; did you mean 'distance'? (it takes: distance, speed, "
-               "tolerance, odometry, stalled, command)") in found
+               "tolerance, odometry, stalled, safety, held_timeout, command)") in found
     assert any("needs input 'distance'" in m for _, m in found)
 
 
