@@ -217,11 +217,7 @@ def candidates(
     distance, nearest = cKDTree(border).query(m.points[:, :2]) if n else (np.zeros(0), np.zeros(0, dtype=np.int64))
     eligible = (m.cell_state(m.points[:, :2]) == Cell.UNKNOWN) & (m.sightings >= params.min_sightings)
     if params.point_clearance > 0.0 and n:
-        rows, cols = m.frame.cell_of(m.points[:, :2])
-        inside = m.frame.inside(rows, cols)
-        room = np.full(n, np.inf)
-        room[inside] = m.clearance[rows[inside], cols[inside]]
-        eligible &= room > params.point_clearance
+        eligible &= m.frame.sample(m.clearance, m.points[:, :2], np.inf) > params.point_clearance
     distance = np.where(eligible, distance, 0.0)
     power = attractive_power(distance, border_cost[nearest], params.eta)
     if math.isfinite(params.nearby):  # eq. 1 among the border points about as close as the closest

@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from enum import IntEnum
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -79,6 +80,15 @@ class GridFrame:
 
     def inside(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         return (rows >= 0) & (rows < self.rows) & (cols >= 0) & (cols < self.cols)
+
+    def sample(self, grid: np.ndarray, xy: np.ndarray, outside: Any, dtype: Any = None) -> np.ndarray:
+        """The value of ``grid`` (of this frame's shape) at the cell of each (x, y); ``outside`` for a
+        point off the grid (``dtype``: the result's, by default ``outside``'s)."""
+        rows, cols = self.cell_of(xy)
+        inside = self.inside(rows, cols)
+        out = np.full(len(rows), outside, dtype=dtype)
+        out[inside] = grid[rows[inside], cols[inside]]
+        return out
 
     def centre_of(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """(x, y) of cell centres (N x 2)."""
@@ -199,11 +209,7 @@ class ExplorationMap:
 
     def cell_state(self, xy: np.ndarray) -> np.ndarray:
         """The :class:`Cell` at each (x, y) (UNKNOWN outside the grid)."""
-        rows, cols = self.frame.cell_of(xy)
-        inside = self.frame.inside(rows, cols)
-        out = np.full(len(rows), Cell.UNKNOWN, dtype=np.uint8)
-        out[inside] = self.cells[rows[inside], cols[inside]]
-        return out
+        return self.frame.sample(self.cells, xy, Cell.UNKNOWN, np.uint8)
 
     @property
     def explored_area(self) -> float:

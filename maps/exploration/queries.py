@@ -75,12 +75,8 @@ def blocking_cells(m: ExplorationMap, path: np.ndarray, radius: float, *, trail:
 
 def _visited(m: ExplorationMap, xy: np.ndarray) -> np.ndarray:
     """Whether each (x, y) lies on a cell of the robot's trail (False outside the grid)."""
-    rows, cols = m.frame.cell_of(xy)
-    inside = m.frame.inside(rows, cols)
-    out = np.zeros(len(rows), dtype=bool)
-    if m.visited is not None:  # always set once the map is built (None only as a constructor argument)
-        out[inside] = m.visited[rows[inside], cols[inside]]
-    return out
+    assert m.visited is not None  # always set once the map is built (None only as a constructor argument)
+    return m.frame.sample(m.visited, xy, False)
 
 
 def moved_onto(before: ExplorationMap, blocking: np.ndarray) -> bool:

@@ -38,11 +38,7 @@ class TravelCost:
 
     def at(self, xy: np.ndarray) -> np.ndarray:
         """G to each (x, y) (inf outside the grid)."""
-        rows, cols = self.frame.cell_of(xy)
-        inside = self.frame.inside(rows, cols)
-        out = np.full(len(rows), np.inf)
-        out[inside] = self.cost[rows[inside], cols[inside]]
-        return out
+        return self.frame.sample(self.cost, xy, np.inf)
 
     def path_to(self, xy: tuple[float, float]) -> np.ndarray:
         """Cell centres (K x 2) from the start to the cell of ``xy``; empty when unreachable."""
