@@ -303,3 +303,35 @@ def test_a_wish_turning_on_the_spot_without_a_goal_in_sight_does_not_end_a_detou
         a.step(0.3, 0.0, PERSON, HERE, float(t))
     turning = a.step(0.0, 0.5, NOTHING, Pose2D(0.6, 0.9, 0.0), 2.5)  # reach: inf
     assert turning.phase == "detour" and not turning.passed
+
+
+def test_a_turn_on_the_spot_away_from_the_remembered_heading_replaces_it():
+    """A detour remembers where the last forward wish headed (0.6 rad/s for 1 s: 0.6 rad left) and a
+    turn on the spot the same way keeps it; a turn on the spot the other way (the node now wants
+    something to the right) stands for itself: the fan's right edge, and no longer the memory."""
+    same, other = avoidance(wait=0.0), avoidance(wait=0.0)
+    on_the_arc = np.array([[0.55, 0.25]])  # ahead and to the left, where the wish's arc goes
+    for a in (same, other):
+        a.step(0.3, 0.6, on_the_arc, HERE, 0.0)
+        assert a.step(0.3, 0.6, on_the_arc, HERE, 0.1).phase == "detour"
+    kept = same.step(0.0, 0.8, PERSON, HERE, 0.2)
+    assert kept.choice is not None and kept.choice.wish == pytest.approx(0.6)
+    turned = other.step(0.0, -0.8, PERSON, HERE, 0.2)
+    assert turned.choice is not None and turned.choice.wish == pytest.approx(-np.radians(120.0))
+    assert other.step(0.0, -0.8, PERSON, Pose2D(0.0, 0.0, -0.3), 0.3).choice.wish == pytest.approx(
+        -np.radians(120.0) + 0.3)  # the new heading is remembered: it does not swing as the robot turns
+
+
+def test_a_wish_held_only_by_the_margin_beside_its_way_creeps_on():
+    """In a doorway (jambs 0.16 m either side of the disc) a wish curving left is held by the clearance,
+    not by the jambs themselves: the footprint goes as far as it means to go and the margin farther.
+    It goes on along the same arc at the creep speed, which needs less room; a point in the way (0.36 m
+    ahead of the disc, short of what the wish needs and the margin) holds the robot as before."""
+    xs = np.linspace(-0.2, 0.8, 11)
+    jambs = np.vstack((np.column_stack((xs, np.full(11, 0.42))), np.column_stack((xs, np.full(11, -0.42)))))
+    creep = avoidance().step(0.3, 0.45, jambs, HERE, 0.0)
+    assert (creep.phase, creep.passed) == ("clear", False)
+    assert (creep.v, creep.w) == pytest.approx((0.1, 0.15))  # the wish's arc (curvature 1.5 /m), slower
+    assert avoidance().step(0.3, 0.0, jambs, HERE, 0.0).passed  # straight through: nothing holds it
+    in_the_way = avoidance().step(0.3, 0.0, np.vstack((jambs, [[0.62, 0.0]])), HERE, 0.0)
+    assert (in_the_way.phase, in_the_way.v) == ("waiting", 0.0)
