@@ -205,7 +205,7 @@ class AvoidObstacles(BearingsDecorator):
             "waits": tally.waits, "waits_cleared": tally.waits_cleared, "wait_time_s": round(tally.wait_time, 2),
             "detours": tally.detours, "detour_length_m": round(tally.detour_length, 3),
             "detour_time_s": round(tally.detour_time, 2), "backoffs": tally.backoffs,
-            "backoff_m": round(tally.backoff_length, 3), "give_ups": tally.give_ups,
+            "backoff_m": round(tally.backoff_length, 3), "creeps": tally.creeps, "give_ups": tally.give_ups,
             "reasons": tally.reasons[-REASONS_KEPT:]}
         for name, value in values.items():
             yield Figure("avoidance", f"{key}.{name}", value)

@@ -133,6 +133,7 @@ class Tally:
     give_ups: int = 0
     backoffs: int = 0  # times the robot backed away along its trail, no direction doing
     backoff_length: float = 0.0  # m backed (odometry)
+    creeps: int = 0  # times a wish held only by what lies beside its way went on at the creep speed
     reasons: list[str] = field(default_factory=list)  # why, per give-up
 
 
@@ -177,6 +178,7 @@ class Avoidance:
         self._pose: Pose2D | None = None  # the last tick's
         self._cut: tuple[float, float, Pose2D] | None = None  # a hold that reset cut short: (since, when, where)
         self._failed: tuple[Pose2D, float, int] | None = None  # the last detour given up: (where, when, its side)
+        self._creeping = False  # the last tick went on at the creep speed
 
     @property
     def line(self) -> DetourLine | None:
@@ -188,6 +190,7 @@ class Avoidance:
         """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
         robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command;
         ``reach``: how far the wish means to go before the node's goal (m; ``inf``: no goal in sight)."""
+        creeping, self._creeping = self._creeping, False
         episode = self._episode
         if episode is not None and episode.backing is not None:
             backing = self._back(episode, Surroundings.of(points, self.avoid), pose, now)
@@ -210,10 +213,9 @@ class Avoidance:
             if not blocked and not (stopped and v > 0.0):
                 self._settle(now)
                 return Decision(v, w, "clear", passed=True)
-            creep = None if stopped else self._squeeze(v, w, around, reach)
+            creep = None if stopped else self._creep(v, w, around, reach, now, creeping)
             if creep is not None:
-                self._settle(now)
-                return Decision(*creep, "clear")
+                return creep
             return self._hold(v, w, around, pose, now, by_monitor=not blocked)
         assert episode is not None
         if not blocked and not episode.by_monitor and not episode.backoffs:  # cleared while waiting (once it stays)
@@ -470,6 +472,20 @@ class Avoidance:
             return False
         need = max(needed_distance(v, self.avoid), at_least)
         return not around.open(v, w, need, goal=reach)
+
+    def _creep(self, v: float, w: float, around: Surroundings, reach: float, now: float, creeping: bool
+               ) -> Decision | None:
+        """Go on at the creep speed where only the margin beside the way holds the wish
+        (:meth:`_squeeze`); None: it does not. A spell of creeping is one event and one count."""
+        slow = self._squeeze(v, w, around, reach)
+        if slow is None:
+            return None
+        self._settle(now)
+        self._creeping = True
+        if creeping:
+            return Decision(*slow, "clear")
+        self.tally.creeps += 1
+        return Decision(*slow, "clear", event=f"held only by what lies beside the way: on at {CREEP:g} m/s")
 
     def _squeeze(self, v: float, w: float, around: Surroundings, reach: float) -> tuple[float, float] | None:
         """A forward wish held only by the margin beside its way: the footprint itself goes as far as the

@@ -329,9 +329,12 @@ def test_a_wish_held_only_by_the_margin_beside_its_way_creeps_on():
     ahead of the disc, short of what the wish needs and the margin) holds the robot as before."""
     xs = np.linspace(-0.2, 0.8, 11)
     jambs = np.vstack((np.column_stack((xs, np.full(11, 0.42))), np.column_stack((xs, np.full(11, -0.42)))))
-    creep = avoidance().step(0.3, 0.45, jambs, HERE, 0.0)
+    a = avoidance()
+    creep = a.step(0.3, 0.45, jambs, HERE, 0.0)
     assert (creep.phase, creep.passed) == ("clear", False)
     assert (creep.v, creep.w) == pytest.approx((0.1, 0.15))  # the wish's arc (curvature 1.5 /m), slower
+    assert creep.event == "held only by what lies beside the way: on at 0.1 m/s"
+    assert a.step(0.3, 0.45, jambs, HERE, 0.1).event == "" and a.tally.creeps == 1  # one spell, one event
     assert avoidance().step(0.3, 0.0, jambs, HERE, 0.0).passed  # straight through: nothing holds it
     in_the_way = avoidance().step(0.3, 0.0, np.vstack((jambs, [[0.62, 0.0]])), HERE, 0.0)
     assert (in_the_way.phase, in_the_way.v) == ("waiting", 0.0)
