@@ -24,7 +24,8 @@ the robot's odometry. Three phases:
   wish passes; ``clear_time`` of that ends the detour, and the motion node steers back to its
   path by itself. A wish to stop or to back away passes (the collision monitor judges it). Where
   the wish heads is kept in the odometry frame from its last forward command, so that a wish to
-  turn on the spot (which says only which way) does not swing the choice as the robot turns. A
+  turn on the spot (which says only which way) does not swing the choice as the robot turns (a
+  turn on the spot the other way from the remembered heading replaces it: :meth:`Avoidance._wish`). A
   hold whose wish was a turn on the spot when first judged (the node means to face something
   beyond the fan's edge: a new goal behind the robot) takes no direction more than
   :data:`FACING` from that edge, and with none backs away (below): driving on the other way takes
