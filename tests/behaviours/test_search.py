@@ -9,9 +9,10 @@ import pytest
 from py_trees.common import Status
 
 from behaviours.route import RouteProgress
-from behaviours.search import SearchPattern, lying_eight
+from behaviours.search import LOOKAHEAD, SearchPattern, lying_eight
 from behaviours.telemetry import report_sections
 from behaviours.testing import BehaviourHarness
+from drivers.interfaces import VelocityCommand
 from perception.geometry import Pose2D
 from perception.observation import Observation
 from tests.behaviours.routes import IdealBase, taught_map
@@ -47,6 +48,33 @@ def test_search_drives_the_eight_and_fails_when_the_trail_stays_lost():
     assert np.ptp(xy[:, 1]) == pytest.approx(1.2, abs=0.08)  # across the eight: two circles side by side
     assert math.dist(xy[0], xy[-1]) < 0.1  # back where it started
     assert report_sections(node)["ltmap"] == {"recoveries": 1, "recoveries_found": 0}
+
+
+def test_after_a_detour_the_search_goes_back_onto_its_eight_and_ends_where_it_started():
+    # the avoidance takes over for 2 s a quarter of the way round (straight on at 0.2 m/s, 0.4 m off
+    # the eight): driven open loop, the rest of the eight would be moved by as much
+    progress = RouteProgress(1, 3, TREE.viewframe_count, 0.0)
+    node = SearchPattern(eights=1, speed=0.2)
+    harness = BehaviourHarness(node, blackboard={"/map/ltmap": TREE, "/map/route_progress": progress})
+    base = IdealBase(harness, Pose2D(20.0, 20.0, 0.0))
+    drive = blind(harness, base)
+    ticks = 0
+
+    def detoured(h: BehaviourHarness) -> None:
+        nonlocal ticks
+        ticks += 1
+        if 30 <= ticks < 70:  # 1.5-3.5 s: a detour straight on, whatever the search asks
+            h.write("/robot/command", VelocityCommand(0.2, 0.0))
+        drive(h)
+
+    status = harness.tick_until(between=detoured, dt=0.05, max_ticks=3000)
+    assert status == Status.FAILURE and "not found" in node.feedback_message
+    xy = np.array([(p.x, p.y) for p in base.trail])
+    eight = lying_eight(1.2, points=720) + [20.0, 20.0]
+    off = np.min(np.hypot(*(xy[:, None, :] - eight[None, :, :]).transpose(2, 0, 1)), axis=1)
+    assert off.max() > 0.25  # the detour took it off the eight ...
+    assert off[70 + 100 :].max() < 0.06  # ... and within 10 s of its end (a turn back, 0.5 m) was back on it
+    assert math.dist(xy[0], xy[-1]) < LOOKAHEAD * 1.2  # it ends where it started
 
 
 def test_search_succeeds_where_the_trail_is_found_and_retargets():
