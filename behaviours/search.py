@@ -3,12 +3,15 @@
 When too few landmarks match the target viewframe (``FollowRoute`` fails), the paper drives a
 search pattern, a "lying 8" 1.2 m across, until the trail is found. Here the eight is two
 circles of diameter ``width / 2`` side by side, the first turning left and the second right,
-laid on the odometry frame where the robot lost the trail and followed as a path (it ends where it
-started): a carrot a fifth of the width (:data:`LOOKAHEAD`) ahead of the robot's place along it,
-steered to by pure pursuit. Until stop 42 the eight was driven open loop, as a fixed speed and turn rate, and every
-detour of the avoidance round a person moved the rest of it: in the office with 3 more people on
-the route, the eights of one search walked the robot 1.5 m through a door into the meeting room,
-where nothing of the route was in view (docs/obstacles.md). Every new
+laid on the odometry frame where the robot lost the trail and followed as a path (it ends where
+it started): a carrot a fifth of the width (:data:`LOOKAHEAD`) ahead of the robot's place along
+it, steered to by pure pursuit. What a detour or a wait keeps it from driving in time (more than
+:data:`LAG` behind the eight driven at ``speed`` from its start) is skipped, so a search ends in
+about the time its eights take even where people stand on them. Until stop 42 the eight was
+driven open loop, as a fixed speed and turn rate, and every detour of the avoidance round a
+person moved the rest of it: in the office with 3 more people on the route, one search's eights
+walked the robot 1.5 m through a door into the meeting room, where nothing of the route was in
+view (docs/obstacles.md). Every new
 observation is matched against the target viewframe and the next ones along the route
 (``window``), then the ones before it (``behind``): the first with enough matches (the same rule
 as ``FollowRoute``'s) and a valid Z-infinity rotation becomes the target, and the node succeeds so
@@ -50,6 +53,7 @@ LOOKAHEAD = 0.25 / 1.2  # of the width: the carrot (0.25 m on the 1.2 m eight: a
 TURN_IN_PLACE = math.radians(60.0)  # the carrot this far off the heading: turn to it on the spot
 TURN_GAIN = 1.5  # 1/s: the turn rate on the spot per rad off (FollowRoute's heading gain)
 AHEAD = 0.5  # of the width: how far along the eight the robot's next place is looked for (not across its crossing)
+LAG = 1.0  # of the width: the most the robot's place falls behind the eight driven on time (the rest is skipped)
 
 
 def lying_eight(width: float, points: int = 64) -> np.ndarray:
@@ -92,14 +96,16 @@ class SearchPattern(BearingsBehaviour):
         self._origin: Pose2D | None = None
         self._logged_origin: Pose2D | None = None
         self._path = np.zeros((0, 2))  # the eights to drive, odometry frame
+        self._along = np.zeros(0)  # the distance along them to each point
         self._index = 0  # the robot's place along them (the nearest point, never going back)
+        self._started = 0.0  # when the eights were laid
         self._stamp: float | None = None
         self._farthest: int | None = None  # the farthest target along the route a search started from
         self._since = 0  # searches started since the target last went farther
         self._reset()
 
     def _reset(self) -> None:
-        self._origin, self._path, self._index, self._stamp = None, np.zeros((0, 2)), 0, None
+        self._origin, self._path, self._along, self._index, self._stamp = None, np.zeros((0, 2)), np.zeros(0), 0, None
 
     def initialise(self) -> None:
         self._reset()
@@ -126,17 +132,20 @@ class SearchPattern(BearingsBehaviour):
         if self._found():
             return self._stop(Status.SUCCESS)
         eights = self.get_input(self.EIGHTS)
+        here, width, speed = np.array([pose.x, pose.y]), self.get_input(self.WIDTH), self.get_input(self.SPEED)
         if self._origin is None:
-            self._origin = pose
-            self._path = _eights_at(pose, self.get_input(self.WIDTH), eights)
-        here, width = np.array([pose.x, pose.y]), self.get_input(self.WIDTH)
-        self._index = _place_along(self._path, self._index, here, AHEAD * width)
+            self._origin, self._started = pose, self.now()
+            self._path = _eights_at(pose, width, eights)
+            self._along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(self._path, axis=0).T))))
+        due = speed * (self.now() - self._started) - LAG * width  # no farther behind the eights driven on time
         last = len(self._path) - 1
-        if self._index == last and math.dist(self._path[last], here) < LOOKAHEAD * width:
+        self._index = min(last, max(_place_along(self._path, self._index, here, AHEAD * width),
+                                    int(np.searchsorted(self._along, due))))
+        if self._index == last and (math.dist(self._path[last], here) < LOOKAHEAD * width or due >= self._along[-1]):
             self.feedback_message = f"the trail was not found in {eights} eights"
             return self._stop(Status.FAILURE)
         carrot = _carrot(self._path, self._index, here, LOOKAHEAD * width)
-        self.set_output(COMMAND, _pursue(pose, carrot, self.get_input(self.SPEED), width))
+        self.set_output(COMMAND, _pursue(pose, carrot, speed, width))
         self.feedback_message = f"searching: {100 * self._index / last:.0f} % of {eights} eights"
         return Status.RUNNING
 

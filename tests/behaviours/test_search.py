@@ -77,6 +77,28 @@ def test_after_a_detour_the_search_goes_back_onto_its_eight_and_ends_where_it_st
     assert math.dist(xy[0], xy[-1]) < LOOKAHEAD * 1.2  # it ends where it started
 
 
+class HeldBase(IdealBase):
+    """A base the avoidance takes 2 m off the eight at once and holds there: commands are not driven."""
+
+    def __call__(self, harness: BehaviourHarness) -> None:
+        self.pose = Pose2D(20.0, 18.0, 0.0)
+        self.trail.append(self.pose)
+        self.sense(self.dt)
+
+
+def test_a_search_kept_off_its_eight_ends_when_the_eight_driven_on_time_would_have():
+    # one eight 1.2 m across is two circles 0.6 m across: 3.77 m, at 0.2 m/s 18.8 s; the robot's place
+    # may lag the eight driven on time by 1.2 m (6 s), then it is moved on: the search ends at 24.8 s
+    progress = RouteProgress(1, 3, TREE.viewframe_count, 0.0)
+    node = SearchPattern(eights=1, speed=0.2, width=1.2)
+    harness = BehaviourHarness(node, blackboard={"/map/ltmap": TREE, "/map/route_progress": progress})
+    base = HeldBase(harness, Pose2D(20.0, 20.0, 0.0))  # the eight is laid here, the robot is held 2 m south
+    start = harness.clock.now()
+    status = harness.tick_until(between=blind(harness, base), dt=0.05, max_ticks=2000)
+    assert status == Status.FAILURE and "not found" in node.feedback_message
+    assert harness.clock.now() - start == pytest.approx(2 * math.pi * 0.6 / 0.2 + 1.2 / 0.2, abs=0.2)
+
+
 def test_search_succeeds_where_the_trail_is_found_and_retargets():
     progress = RouteProgress(1, 3, TREE.viewframe_count, 0.0)
     node = SearchPattern(window=2)
