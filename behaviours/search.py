@@ -47,7 +47,7 @@ from behaviours.registry import register
 from behaviours.route import MIN_MATCHES, OBSERVATION_IN, PROGRESS_IN, PROGRESS_KEY, RouteProgress, sees
 from behaviours.telemetry import Drawing, Figure, Lines
 from drivers.interfaces import STOP, VelocityCommand
-from perception.geometry import Pose2D, wrap_angle
+from perception.geometry import Pose2D, frame_to_parent, wrap_angle
 
 LOOKAHEAD = 0.25 / 1.2  # of the width: the carrot (0.25 m on the 1.2 m eight: a chord of its circles to pursue)
 TURN_IN_PLACE = math.radians(60.0)  # the carrot this far off the heading: turn to it on the spot
@@ -192,9 +192,7 @@ class SearchPattern(BearingsBehaviour):
 def _eights_at(origin: Pose2D, width: float, eights: int) -> np.ndarray:
     """``eights`` lying eights ``width`` across, one after the other, from ``origin`` (odometry frame)."""
     one = lying_eight(width)
-    local = np.vstack([*[one[:-1]] * eights, one[-1:]])
-    c, s = math.cos(origin.theta), math.sin(origin.theta)
-    return np.column_stack((origin.x + c * local[:, 0] - s * local[:, 1], origin.y + s * local[:, 0] + c * local[:, 1]))
+    return frame_to_parent(origin, np.vstack([*[one[:-1]] * eights, one[-1:]]))
 
 
 def _place_along(path: np.ndarray, index: int, here: np.ndarray, reach: float) -> int:
