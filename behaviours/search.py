@@ -139,7 +139,7 @@ class SearchPattern(BearingsBehaviour):
             self._along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(self._path, axis=0).T))))
         due = speed * (self.now() - self._started) - LAG * width  # no farther behind the eights driven on time
         last = len(self._path) - 1
-        self._index = min(last, max(_place_along(self._path, self._index, here, AHEAD * width),
+        self._index = min(last, max(_place_along(self._path, self._along, self._index, here, AHEAD * width),
                                     int(np.searchsorted(self._along, due))))
         if self._index == last and (math.dist(self._path[last], here) < LOOKAHEAD * width or due >= self._along[-1]):
             self.feedback_message = f"the trail was not found in {eights} eights"
@@ -195,12 +195,11 @@ def _eights_at(origin: Pose2D, width: float, eights: int) -> np.ndarray:
     return frame_to_parent(origin, np.vstack([*[one[:-1]] * eights, one[-1:]]))
 
 
-def _place_along(path: np.ndarray, index: int, here: np.ndarray, reach: float) -> int:
-    """The robot's place along ``path``: the point nearest ``here`` within ``reach`` metres on from the
-    last place (never going back, and never across to the other side of the eight where it crosses itself)."""
-    ahead = path[index:]
-    along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ahead, axis=0).T))))
-    window = ahead[along <= reach]
+def _place_along(path: np.ndarray, along: np.ndarray, index: int, here: np.ndarray, reach: float) -> int:
+    """The robot's place along ``path`` (``along``: the distance along it to each point): the point
+    nearest ``here`` within ``reach`` metres on from the last place (never going back, and never
+    across to the other side of the eight where it crosses itself)."""
+    window = path[index : int(np.searchsorted(along, along[index] + reach, side="right"))]
     return index + int(np.argmin(np.hypot(*(window - here).T)))
 
 
