@@ -47,6 +47,7 @@ from behaviours.registry import register
 from behaviours.route import MIN_MATCHES, OBSERVATION_IN, PROGRESS_IN, PROGRESS_KEY, RouteProgress, sees
 from behaviours.telemetry import Drawing, Figure, Lines
 from drivers.interfaces import STOP, VelocityCommand
+from maps.pursuit import carrot, place_along
 from perception.geometry import Pose2D, frame_to_parent, wrap_angle
 
 LOOKAHEAD = 0.25 / 1.2  # of the width: the carrot (0.25 m on the 1.2 m eight: a chord of its circles to pursue)
@@ -139,13 +140,14 @@ class SearchPattern(BearingsBehaviour):
             self._along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(self._path, axis=0).T))))
         due = speed * (self.now() - self._started) - LAG * width  # no farther behind the eights driven on time
         last = len(self._path) - 1
-        self._index = min(last, max(_place_along(self._path, self._along, self._index, here, AHEAD * width),
-                                    int(np.searchsorted(self._along, due))))
+        window = int(np.searchsorted(self._along, self._along[self._index] + AHEAD * width, side="right"))
+        self._index = min(last, max(place_along(self._path, self._index, window, here),  # never going back,
+                                    int(np.searchsorted(self._along, due))))  # nor across the eight's crossing
         if self._index == last and (math.dist(self._path[last], here) < LOOKAHEAD * width or due >= self._along[-1]):
             self.feedback_message = f"the trail was not found in {eights} eights"
             return self._stop(Status.FAILURE)
-        carrot = _carrot(self._path, self._index, here, LOOKAHEAD * width)
-        self.set_output(COMMAND, _pursue(pose, carrot, speed, width))
+        target = carrot(self._path, self._index, here, LOOKAHEAD * width)
+        self.set_output(COMMAND, _pursue(pose, target, speed, width))
         self.feedback_message = f"searching: {100 * self._index / last:.0f} % of {eights} eights"
         return Status.RUNNING
 
@@ -193,21 +195,6 @@ def _eights_at(origin: Pose2D, width: float, eights: int) -> np.ndarray:
     """``eights`` lying eights ``width`` across, one after the other, from ``origin`` (odometry frame)."""
     one = lying_eight(width)
     return frame_to_parent(origin, np.vstack([*[one[:-1]] * eights, one[-1:]]))
-
-
-def _place_along(path: np.ndarray, along: np.ndarray, index: int, here: np.ndarray, reach: float) -> int:
-    """The robot's place along ``path`` (``along``: the distance along it to each point): the point
-    nearest ``here`` within ``reach`` metres on from the last place (never going back, and never
-    across to the other side of the eight where it crosses itself)."""
-    window = path[index : int(np.searchsorted(along, along[index] + reach, side="right"))]
-    return index + int(np.argmin(np.hypot(*(window - here).T)))
-
-
-def _carrot(path: np.ndarray, index: int, here: np.ndarray, lookahead: float) -> np.ndarray:
-    """The first point of ``path`` after the robot's place at least ``lookahead`` from it (else the end)."""
-    ahead = path[index:]
-    far = np.flatnonzero(np.hypot(*(ahead - here).T) >= lookahead)
-    return ahead[far[0]] if len(far) else ahead[-1]
 
 
 def _pursue(pose: Pose2D, carrot: np.ndarray, speed: float, width: float) -> VelocityCommand:
