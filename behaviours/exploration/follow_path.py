@@ -91,11 +91,11 @@ from behaviours.ports import InputPort, OutputPort, Ref
 from behaviours.registry import register
 from behaviours.telemetry import Drawing, Figure, Lines
 from drivers.interfaces import STOP, VelocityCommand
+from maps import pursuit
 from maps.exploration.goal import Goal
 from maps.exploration.grid import Cell, ExplorationMap
 from maps.exploration.queries import blocking_cells, cells_around, free_travel, moved_onto
 from maps.exploration.travel import travel_cost
-from maps.pursuit import carrot, place_along
 from perception.geometry import Pose2D, wrap_angle
 from perception.ranges import RangeScan
 
@@ -326,7 +326,7 @@ class FollowPath(BearingsBehaviour):
 
     def _nearest(self, here: np.ndarray) -> int:
         """The path point nearest the robot, searching forward from the last one (no going back)."""
-        return place_along(self.path, self.index, self.index + 40, here)
+        return pursuit.place_along(self.path, self.index, self.index + 40, here)
 
     def _carrot(self, here: np.ndarray, lookahead: float | None = None) -> tuple[np.ndarray, float]:
         """The first path point ``lookahead`` (default: the input's) away from the robot, and the path
@@ -335,7 +335,7 @@ class FollowPath(BearingsBehaviour):
         steps = np.hypot(*np.diff(ahead, axis=0).T) if len(ahead) > 1 else np.zeros(0)
         remaining = float(steps.sum()) + float(np.hypot(*(ahead[0] - here)))
         lookahead = self.get_input(self.LOOKAHEAD) if lookahead is None else lookahead
-        return carrot(self.path, self.index, here, lookahead), remaining
+        return pursuit.carrot(self.path, self.index, here, lookahead), remaining
 
     def _ahead(self, ahead: np.ndarray) -> np.ndarray:
         """The points of the path ``ahead`` within its first ``check_distance``."""
