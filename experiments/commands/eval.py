@@ -36,9 +36,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Run an area's evaluation episodes through the sweep runner and print one JSON object of "
                     "named figures (--json) or a table. Works on any world file the simulator reads.",
         epilog="Areas and their --option names (an unknown name is refused with the list): exploration "
-               "(localisation, people, variants; docs/exploration.md), ltmap (camera, route, min_landmarks, "
-               "goal_tolerance, rotation, gap_filling, odometry, cuts, people; docs/ltmap.md), roadmap (targets, "
-               "starts, people; docs/roadmap.md). people=N: N people drawn from the seed in the way of the robot.",
+               "(localisation, people, rest, variants; docs/exploration.md), ltmap (camera, route, min_landmarks, "
+               "goal_tolerance, rotation, gap_filling, odometry, cuts, people, rest; docs/ltmap.md), roadmap "
+               "(targets, starts, people, rest; docs/roadmap.md). people=N: N people drawn from the seed in the way "
+               "of the robot; rest=S: the most each walking person rests at each end of their walk (default 2 s).",
     )
     parser.add_argument("area", choices=sorted(AREAS), help="what to evaluate")
     parser.add_argument("--world", required=True, metavar="NAME|PATH", help="a shipped world or a world file")

@@ -103,6 +103,7 @@ OPTIONS = {
     "localisation": "how the robot localises: visual (the stereo pair's own features; default), ideal (the "
                     "simulator's identified landmarks, an oracle), or visual,ideal (both, side by side)",
     crowd.OPTION: crowd.HELP + " (in the rooms)",
+    crowd.REST_OPTION: crowd.REST_HELP,
     "variants": f"the variants to run, comma-separated ({', '.join(VARIANTS)}; default "
                 f"{','.join(DEFAULT_VARIANTS)}; the method always runs)",
 }
@@ -118,6 +119,7 @@ class Settings:
     people: int = 0  # people in the rooms
     variants: tuple[str, ...] = DEFAULT_VARIANTS
     localisations: tuple[str, ...] = ("visual",)  # LOCALISATIONS' names, each a set of columns
+    rest: float = crowd.WAIT_S  # s: the most a walking person rests at each end
 
 
 def check_world(world: str) -> FloorGrid:
@@ -148,7 +150,8 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
         if LOCALISATIONS[name] not in cameras:
             raise ValueError(f"localisation {name} needs the camera {LOCALISATIONS[name]!r}, which world {world!r} "
                              f"does not have (cameras: {', '.join(sorted(cameras))})")
-    return Settings(crowd.parse_people(extra.get(crowd.OPTION)), variants=variants, localisations=names)
+    return Settings(crowd.parse_people(extra.get(crowd.OPTION)), variants=variants, localisations=names,
+                    rest=crowd.parse_rest(extra.get(crowd.REST_OPTION)))
 
 
 def column(variant: str, localisation: str) -> str:
@@ -166,14 +169,14 @@ def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: f
 
 
 def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
-                folder: Path) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
-    """Per seed, the world its runs go in (with ``count`` people in the rooms: module docstring) and
-    those people; the world itself when there are none."""
+                folder: Path, rest: float = crowd.WAIT_S) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
+    """Per seed, the world its runs go in (with ``count`` people in the rooms, resting up to ``rest``
+    s: module docstring) and those people; the world itself when there are none."""
     if not count:
         return dict.fromkeys(seeds, world), {}
     loaded = load_world(world)
     start = [(loaded.start.x, loaded.start.y)]
-    people = {seed: crowd.in_rooms(loaded, floor, count, seed, keep_clear=start) for seed in seeds}
+    people = {seed: crowd.in_rooms(loaded, floor, count, seed, keep_clear=start, rest=rest) for seed in seeds}
     worlds = {seed: str(crowd.world_with_people(world, folder / "people" / f"s{seed:04d}" / f"{Path(world).stem}.yaml",
                                                 people[seed])) for seed in seeds}
     return worlds, people
@@ -382,7 +385,8 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         options.world, options.extra)
     localisations, count = settings.localisations, settings.people
     world = load_world(options.world)
-    where, people = seed_worlds(options.world, count, options.seeds, floor, Path(options.results_dir).resolve())
+    where, people = seed_worlds(options.world, count, options.seeds, floor, Path(options.results_dir).resolve(),
+                                settings.rest)
     todo = episodes(where, options.seeds, options.max_time_s, settings.variants, localisations)
     rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,
                      progress=options.progress, resume=resume)
@@ -419,7 +423,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
             for key in ("map_on_obstacles_m2", "path_length_m"):
                 out[f"{name}_visual_vs_ideal.{key.rsplit('_', 1)[0]}_ratio"] = _ratio(visual.get(key), ideal.get(key))
     out["runs"] = sorted(runs, key=lambda r: (r["variant"], r["seed"]))
-    return {**out, **crowd.figures(people, count)} if count else out
+    return {**out, **crowd.figures(people, count, settings.rest)} if count else out
 
 
 def format_table(figures: dict[str, Any]) -> str:

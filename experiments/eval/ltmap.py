@@ -101,6 +101,7 @@ OPTIONS = {
     "cuts": "repeat from the full map and at most this many levels cut (default: every level down to one; 0: "
             "the full map alone, e.g. to measure obstacles or people in a quarter of the time)",
     crowd.OPTION: crowd.HELP + " (the repeats': on the taught route or across it)",
+    crowd.REST_OPTION: crowd.REST_HELP,
 }
 ROTATIONS = ("zinf", "compass")
 TEACH, FOLLOW = "teach_route", "follow_route"
@@ -126,6 +127,7 @@ class Settings:
     people: int = 0  # people in the repeats' world
     cuts: int | None = None  # at most this many levels cut (None: every level)
     odometry: bool = False  # FollowRoute drives by the taught odometry while lost
+    rest: float = crowd.WAIT_S  # s: the most a walking person rests at each end
 
 
 def check_world(world: str) -> World:
@@ -165,7 +167,8 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
         if cuts < 0:
             raise ValueError(f"cuts must be >= 0 (0: the full map alone), got {cuts}")
     return Settings(camera, route, min_landmarks, tolerance, rotation, _on_off(extra, "gap_filling"),
-                    crowd.parse_people(extra.get(crowd.OPTION)), cuts, _on_off(extra, "odometry", "off"))
+                    crowd.parse_people(extra.get(crowd.OPTION)), cuts, _on_off(extra, "odometry", "off"),
+                    crowd.parse_rest(extra.get(crowd.REST_OPTION)))
 
 
 def _on_off(extra: Mapping[str, str], name: str, default: str = "on") -> bool:
@@ -365,7 +368,8 @@ def repeat_worlds(world: str, loaded: World, settings: Settings, seeds: list[int
     if not settings.people:
         return {seed: world for seed in seeds}, {}
     route = settings.route.world_xy
-    people = {seed: crowd.on_ways(loaded, [route], settings.people, seed, keep_clear=[route[0], route[-1]])
+    people = {seed: crowd.on_ways(loaded, [route], settings.people, seed, keep_clear=[route[0], route[-1]],
+                                  rest=settings.rest)
               for seed in seeds}
     worlds = {seed: str(crowd.world_with_people(world, folder / "people" / f"s{seed:04d}" / f"{Path(world).stem}.yaml",
                                           people[seed])) for seed in seeds}
@@ -419,7 +423,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         figures = repeat_figures(taught, read_report(folder, episode.id), level, tolerance[episode.seed])
         runs.append({"seed": episode.seed, **figures})
     out = summarise(world, settings, len(options.seeds), teach_rows, failed, runs)
-    return {**out, **crowd.figures(people, settings.people)} if settings.people else out
+    return {**out, **crowd.figures(people, settings.people, settings.rest)} if settings.people else out
 
 
 def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dict[str, Any]],

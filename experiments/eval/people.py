@@ -14,11 +14,13 @@ even odds:
   for impossible), or
 - **crossing** it: walking back and forth across it, square to it, up to :data:`CROSSING` m to
   each side (cut where a wall, box or pillar comes nearer than the person's radius), at a speed
-  in :data:`SPEEDS`, waiting up to :data:`WAIT_S` s at each end. A crossing goes a body's width
-  to each side of the way; a person who finds no place so (a route along a corridor 1.5 m wide,
-  0.5 m on each side of its middle: before, such a route got nobody at all) may cross shorter,
-  half a body's width to each side, when, paused at either end, they leave the robot a way past
-  as a standing person must.
+  in :data:`SPEEDS`, resting at each end up to ``--option rest=S`` seconds (:data:`WAIT_S`, 2 s, by
+  default: people who pace a corridor with hardly a rest are a wall the robot must time its way
+  through, and a longer rest changes only how long each person rests: docs/obstacles.md, stop 43).
+  A crossing goes a body's width to each side of the way; a person who finds no place so (a route
+  along a corridor 1.5 m wide, 0.5 m on each side of its middle: before, such a route got nobody
+  at all) may cross shorter, half a body's width to each side, when, paused at either end, they
+  leave the robot a way past as a standing person must.
 
 Where "the way" is depends on the area: the taught route (``ltmap``), the straight lines between
 the targets (``roadmap``), or anywhere in the rooms (``exploration``: :func:`in_rooms`, a walker
@@ -55,7 +57,11 @@ KEEP_CLEAR_M = 1.0  # m from where runs start and end
 SPACING = 2 * RADIUS + 0.2  # m between two people's centres
 CROSSING = (1.0, 2.0)  # m to each side of the way a crossing person walks
 SPEEDS = (0.5, 1.2)  # m/s
-WAIT_S = 2.0
+WAIT_S = 2.0  # s: the most a walking person rests at each end of their walk, by default (the 'rest' option)
+REST_OPTION = "rest"
+MAX_REST = 60.0  # s
+REST_HELP = (f"s: the most a walking person rests at each end of their walk (0 to {MAX_REST:g}, default {WAIT_S:g}); "
+             "each person's rest is drawn up to it, the people, their ways and speeds stay those of the seed")
 WALK = (1.5, 4.0)  # m: how far a walker in a room goes
 DRAWS = 500  # positions tried per person
 STEP = 0.05  # m: how finely a walk is checked against the surfaces
@@ -68,6 +74,19 @@ GRID = 0.05  # m: the cells the way past is looked for in
 def parse_people(text: str | None) -> int:
     """The ``people`` option: 0 to :data:`MAX_PEOPLE` (default 0); ``ValueError`` otherwise."""
     return count_option("people", text, default=0, maximum=MAX_PEOPLE)
+
+
+def parse_rest(text: str | None) -> float:
+    """The ``rest`` option: 0 to :data:`MAX_REST` seconds (default :data:`WAIT_S`); ``ValueError`` otherwise."""
+    if text is None:
+        return WAIT_S
+    try:
+        rest = float(text)
+    except ValueError:
+        raise ValueError(f"{REST_OPTION}: a number of seconds expected, got {text!r}") from None
+    if not 0.0 <= rest <= MAX_REST:
+        raise ValueError(f"{REST_OPTION} must be 0 to {MAX_REST:g} s, got {text}")
+    return rest
 
 
 @dataclass(frozen=True)
@@ -178,9 +197,10 @@ def _distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def on_ways(world: World, ways: Sequence[np.ndarray], count: int, seed: int, *,
-            keep_clear: Sequence[Sequence[float]]) -> list[Walker]:
+            keep_clear: Sequence[Sequence[float]], rest: float = WAIT_S) -> list[Walker]:
     """``count`` people standing on or crossing the polylines ``ways`` (world, N x 2 each), drawn
-    from ``seed``: a point uniform along all the ways together, then standing or crossing."""
+    from ``seed``: a point uniform along all the ways together, then standing or crossing (resting
+    up to ``rest`` s at each end)."""
     rng = np.random.default_rng([seed, count, 0x9E09])
     placer = _Placer(world, keep_clear)
     arcs = [np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(way, axis=0).T)))) for way in ways]  # arc lengths
@@ -193,14 +213,14 @@ def on_ways(world: World, ways: Sequence[np.ndarray], count: int, seed: int, *,
         # short crossings only for a person no other place was found for (and from a stream of their
         # own): where the ways leave room, the people are those drawn before short crossings existed
         for draws, short in ((rng, False), (np.random.default_rng([seed, count, 0x9E0B, person]), True)):
-            if _place_on_ways(placer, ways, arcs, segments, lengths, draws, short=short):
+            if _place_on_ways(placer, ways, arcs, segments, lengths, draws, short=short, rest=rest):
                 break
     return placer.placed
 
 
 def _place_on_ways(placer: _Placer, ways: Sequence[np.ndarray], arcs: list[np.ndarray],
                    segments: list[tuple[np.ndarray, np.ndarray, int, int]], lengths: np.ndarray,
-                   rng: np.random.Generator, *, short: bool) -> bool:
+                   rng: np.random.Generator, *, short: bool, rest: float) -> bool:
     """One person on or across the ways in up to :data:`DRAWS` draws from ``rng``; whether placed."""
     for _ in range(DRAWS):
         k = int(rng.choice(len(segments), p=lengths / lengths.sum()))
@@ -208,7 +228,7 @@ def _place_on_ways(placer: _Placer, ways: Sequence[np.ndarray], arcs: list[np.nd
         u = rng.uniform()
         p = a + (b - a) * u
         around = _on_way(ways[w], arcs[w], arcs[w][i] + u * lengths[k], (-PAST, PAST))
-        walker = _standing_or_crossing(placer, p, (b - a) / lengths[k], around, rng, short=short)
+        walker = _standing_or_crossing(placer, p, (b - a) / lengths[k], around, rng, short=short, rest=rest)
         if walker is not None and placer.keeps_ways(walker):
             placer.placed.append(walker)
             if len(walker.path) == 1:
@@ -227,7 +247,7 @@ def _on_way(way: np.ndarray, arc: np.ndarray, s: float, offsets: Sequence[float]
 
 def _standing_or_crossing(placer: _Placer, p: np.ndarray, along: np.ndarray,
                           around: tuple[np.ndarray, np.ndarray], rng: np.random.Generator, *,
-                          short: bool = False) -> Walker | None:
+                          short: bool = False, rest: float = WAIT_S) -> Walker | None:
     if rng.uniform() < 0.5:
         return Walker(((float(p[0]), float(p[1])),)) if placer.fits(p) and placer.leaves_a_way(p, *around) else None
     if not placer.apart(p, p):  # the crossing passes through p
@@ -243,11 +263,11 @@ def _standing_or_crossing(placer: _Placer, p: np.ndarray, along: np.ndarray,
         return None  # a short crossing (a corridor's width): paused at either end, they leave a way past
     first, last = (a, b) if rng.uniform() < 0.5 else (b, a)
     return Walker(((float(first[0]), float(first[1])), (float(last[0]), float(last[1]))),
-                  float(rng.uniform(*SPEEDS)), float(rng.uniform(0.0, WAIT_S)))
+                  float(rng.uniform(*SPEEDS)), float(rng.uniform(0.0, rest)))
 
 
 def in_rooms(world: World, grid: FloorGrid, count: int, seed: int, *,
-             keep_clear: Sequence[Sequence[float]]) -> list[Walker]:
+             keep_clear: Sequence[Sequence[float]], rest: float = WAIT_S) -> list[Walker]:
     """``count`` people on the floor the robot reaches (``grid``), drawn from ``seed``: standing, or
     walking back and forth to another reachable point :data:`WALK` m away in a straight free line."""
     rng = np.random.default_rng([seed, count, 0x9E0A])
@@ -266,7 +286,7 @@ def in_rooms(world: World, grid: FloorGrid, count: int, seed: int, *,
                 q = p + rng.uniform(*WALK) * np.array([math.cos(heading), math.sin(heading)])
                 on_floor = bool(grid.reachable_at(q[None, :])[0])
                 walker = Walker(((float(p[0]), float(p[1])), (float(q[0]), float(q[1]))), float(rng.uniform(*SPEEDS)),
-                                float(rng.uniform(0.0, WAIT_S))) if on_floor and placer.fits(p, q) else None
+                                float(rng.uniform(0.0, rest))) if on_floor and placer.fits(p, q) else None
             if walker is not None:
                 placer.placed.append(walker)
                 break
@@ -285,9 +305,10 @@ def world_with_people(world: str | Path, out: Path, people: Sequence[Walker]) ->
     return out
 
 
-def figures(people: dict[int, list[Walker]], asked: int) -> dict[str, Any]:
-    """What the evaluation records of its people: how many were asked for, placed per seed, and where."""
-    return {"people": asked,
+def figures(people: dict[int, list[Walker]], asked: int, rest: float = WAIT_S) -> dict[str, Any]:
+    """What the evaluation records of its people: how many were asked for, their longest rest, placed
+    per seed, and where."""
+    return {"people": asked, "people.rest": rest,
             "people.placed": {str(seed): len(walkers) for seed, walkers in sorted(people.items())},
             "people.paths": {str(seed): [w.entry() for w in walkers] for seed, walkers in sorted(people.items())}}
 
@@ -297,4 +318,7 @@ def table_line(figures: Mapping[str, Any]) -> list[str]:
     if not figures.get(OPTION):
         return []
     placed = ", ".join(f"seed {seed}: {n}" for seed, n in figures.get("people.placed", {}).items())
-    return [f"people: {figures[OPTION]} asked per seed, standing on or walking across the way ({placed} placed)"]
+    rest = figures.get("people.rest", WAIT_S)
+    resting = f", resting up to {rest:g} s at each end" if rest != WAIT_S else ""
+    return [f"people: {figures[OPTION]} asked per seed, standing on or walking across the way{resting} "
+            f"({placed} placed)"]

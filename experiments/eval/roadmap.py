@@ -96,6 +96,7 @@ OPTIONS = {
                "at and reach from the start; 4 placed when fewer than 2)",
     "starts": f"random start poses per seed to navigate from (default {DEFAULT_STARTS}; 0: learning only)",
     crowd.OPTION: crowd.HELP + " (the navigations': between the targets)",
+    crowd.REST_OPTION: crowd.REST_HELP,
 }
 LEARN, GOTO = "learn_targets", "goto_target"
 POSITION_OK, HEADING_OK = 0.15, 5.0  # m, deg: the issue's thresholds for a target and a navigation
@@ -114,6 +115,7 @@ class Settings:
     starts: int
     source: str = NAMED
     people: int = 0  # people in the navigations' world
+    rest: float = crowd.WAIT_S  # s: the most a walking person rests at each end
 
 
 @dataclass(frozen=True)
@@ -165,7 +167,8 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     starts = parse_starts(extra.get("starts"))
     if starts:
         random_starts(loaded, 1, 0, grid=grid)  # ValueError: nowhere clear enough to start from
-    return Settings(targets, starts, source, crowd.parse_people(extra.get(crowd.OPTION)))
+    return Settings(targets, starts, source, crowd.parse_people(extra.get(crowd.OPTION)),
+                    crowd.parse_rest(extra.get(crowd.REST_OPTION)))
 
 
 def choose_targets(text: str | None, world: World, usable: Mapping[str, Pose2D]) -> tuple[tuple[str, ...], str]:
@@ -279,7 +282,7 @@ def navigation_worlds(loaded: World, settings: Settings, targets: Mapping[int, S
         ways = [np.array([a, b]) for i, a in enumerate(spots) for b in spots[i + 1:]]
         clear = [*spots, (loaded.start.x, loaded.start.y),
                  *((p.x, p.y) for p in random_starts(loaded, settings.starts, seed, grid=grid))]
-        people[seed] = crowd.on_ways(loaded, ways, settings.people, seed, keep_clear=clear)
+        people[seed] = crowd.on_ways(loaded, ways, settings.people, seed, keep_clear=clear, rest=settings.rest)
         here = seed_folder(folder, t.world, seed) / "people" / f"{Path(world_path(t.world)).stem}.yaml"
         worlds[seed] = str(crowd.world_with_people(t.world, here, people[seed]))
     return worlds, people
@@ -464,7 +467,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     gotos = [goto_figures(p, read_report(folder, p.episode.id), rows.get(p.episode.id), truth[p.episode.seed][p.goal])
              for p in plans]
     out = summarise(loaded.name, settings, learns, gotos, truth)
-    return {**out, **crowd.figures(people, settings.people)} if settings.people else out
+    return {**out, **crowd.figures(people, settings.people, settings.rest)} if settings.people else out
 
 
 # ------------------------------------------------------------------------------------------------

@@ -21,6 +21,7 @@ from experiments.eval.people import (
     in_rooms,
     on_ways,
     parse_people,
+    parse_rest,
     table_line,
     world_with_people,
 )
@@ -68,6 +69,39 @@ def test_the_option_is_a_count_of_people(text, count):
 def test_a_bad_count_is_refused(text, message):
     with pytest.raises(ValueError, match=message):
         parse_people(text)
+
+
+@pytest.mark.parametrize(("text", "rest"), [(None, 2.0), ("0", 0.0), ("10", 10.0), ("60", 60.0)])
+def test_the_rest_option_is_seconds(text, rest):
+    assert parse_rest(text) == rest
+
+
+@pytest.mark.parametrize(("text", "message"), [("-1", "0 to 60"), ("61", "0 to 60"), ("long", "a number of seconds")])
+def test_a_bad_rest_is_refused(text, message):
+    with pytest.raises(ValueError, match=message):
+        parse_rest(text)
+
+
+def test_a_longer_rest_changes_the_rests_alone(world_file):
+    """The same seed's people, places and speeds with any rest: each rest drawn up to it is the same
+    fraction of it (0-2 s by default, 0-10 s with rest=10)."""
+    world = load_world(world_file(HALL))
+    short, long = (on_ways(world, [ROUTE], 6, seed=3, keep_clear=[ROUTE[0]], rest=r) for r in (2.0, 10.0))
+    assert [(p.path, p.speed) for p in short] == [(p.path, p.speed) for p in long]
+    walkers = [(a, b) for a, b in zip(short, long, strict=True) if len(a.path) == 2]
+    assert walkers and all(b.wait_s == pytest.approx(5.0 * a.wait_s) and b.wait_s <= 10.0 for a, b in walkers)
+    floor = reachable_floor(world)
+    start = [(world.start.x, world.start.y)]
+    rooms = [in_rooms(world, floor, 5, seed=0, keep_clear=start, rest=r) for r in (2.0, 10.0)]
+    assert [p.path for p in rooms[0]] == [p.path for p in rooms[1]]
+
+
+@pytest.mark.parametrize("area", [ltmap, roadmap, exploration])
+def test_every_area_takes_the_rest(area):
+    assert area.check_options("lab", {"people": "3", "rest": "10"}).rest == 10.0
+    assert area.check_options("lab", {"people": "3"}).rest == 2.0
+    with pytest.raises(ValueError, match="rest must be 0 to 60"):
+        area.check_options("lab", {"rest": "90"})
 
 
 def test_people_stand_on_the_way_or_walk_across_it_clear_of_its_ends(world_file):
@@ -272,3 +306,6 @@ def test_the_tables_say_how_many_people_were_placed():
     assert table_line(figures) == ["people: 3 asked per seed, standing on or walking across the way (seed 0: 3, "
                                    "seed 1: 2 placed)"]
     assert table_line({"people": 0}) == [] and table_line({}) == []
+    assert table_line({**figures, "people.rest": 10.0}) == [
+        "people: 3 asked per seed, standing on or walking across the way, resting up to 10 s at each end (seed 0: "
+        "3, seed 1: 2 placed)"]
