@@ -18,10 +18,13 @@ To add an area, write its module and name it in :data:`AREAS`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, TextIO, TypeVar
+
+N = TypeVar("N", int, float)  # the number an area option holds
 
 AREAS = {
     "exploration": "experiments.eval.exploration",
@@ -47,15 +50,22 @@ class EvalOptions:
     checked: tuple[Any, Any] | None = None
 
 
-def count_option(name: str, text: str | None, *, default: int, maximum: int) -> int:
-    """An area option that counts something (``people``, ``starts``): 0 to ``maximum``; ``default``
-    when not given; a ``ValueError`` naming the option otherwise."""
+def bounded_option(name: str, text: str | None, *, convert: Callable[[str], N], default: N, maximum: N,
+                   expected: str, unit: str = "") -> N:
+    """An area option that is a number from 0 to ``maximum`` (``unit`` in the message); ``default``
+    when not given; a ``ValueError`` naming the option otherwise (``expected``: what it should be)."""
     if text is None:
         return default
     try:
-        count = int(text)
+        value = convert(text)
     except ValueError:
-        raise ValueError(f"{name}: an integer expected, got {text!r}") from None
-    if not 0 <= count <= maximum:
-        raise ValueError(f"{name} must be 0 to {maximum}, got {count}")
-    return count
+        raise ValueError(f"{name}: {expected} expected, got {text!r}") from None
+    if not 0 <= value <= maximum:
+        raise ValueError(f"{name} must be 0 to {maximum:g}{unit}, got {value:g}")
+    return value
+
+
+def count_option(name: str, text: str | None, *, default: int, maximum: int) -> int:
+    """An area option that counts something (``people``, ``starts``): 0 to ``maximum``; ``default``
+    when not given; a ``ValueError`` naming the option otherwise."""
+    return bounded_option(name, text, convert=int, default=default, maximum=maximum, expected="an integer")

@@ -46,7 +46,7 @@ from behaviours.avoidance import AvoidObstacles
 from drivers.sim.floor import FloorGrid, rasterise, reached_from
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, shipped_worlds
-from experiments.eval import count_option
+from experiments.eval import bounded_option, count_option
 
 MAX_PEOPLE = 20
 OPTION = "people"
@@ -78,15 +78,8 @@ def parse_people(text: str | None) -> int:
 
 def parse_rest(text: str | None) -> float:
     """The ``rest`` option: 0 to :data:`MAX_REST` seconds (default :data:`WAIT_S`); ``ValueError`` otherwise."""
-    if text is None:
-        return WAIT_S
-    try:
-        rest = float(text)
-    except ValueError:
-        raise ValueError(f"{REST_OPTION}: a number of seconds expected, got {text!r}") from None
-    if not 0.0 <= rest <= MAX_REST:
-        raise ValueError(f"{REST_OPTION} must be 0 to {MAX_REST:g} s, got {text}")
-    return rest
+    return bounded_option(REST_OPTION, text, convert=float, default=WAIT_S, maximum=MAX_REST,
+                          expected="a number of seconds", unit=" s")
 
 
 @dataclass(frozen=True)
