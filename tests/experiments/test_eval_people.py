@@ -60,26 +60,21 @@ def crosses(way: np.ndarray, walker: Walker) -> bool:
     return min(distance_to(way, p) for p in samples) < 0.03
 
 
-@pytest.mark.parametrize(("text", "count"), [(None, 0), ("0", 0), ("4", 4), ("20", 20)])
-def test_the_option_is_a_count_of_people(text, count):
-    assert parse_people(text) == count
+@pytest.mark.parametrize(("parse", "text", "value"), [
+    (parse_people, None, 0), (parse_people, "0", 0), (parse_people, "4", 4), (parse_people, "20", 20),  # a count
+    (parse_rest, None, 2.0), (parse_rest, "0", 0.0), (parse_rest, "10", 10.0), (parse_rest, "60", 60.0),  # seconds
+])
+def test_the_options_read_a_count_of_people_and_seconds_of_rest(parse, text, value):
+    assert parse(text) == value
 
 
-@pytest.mark.parametrize(("text", "message"), [("-1", "0 to 20"), ("21", "0 to 20"), ("two", "an integer")])
-def test_a_bad_count_is_refused(text, message):
+@pytest.mark.parametrize(("parse", "text", "message"), [
+    (parse_people, "-1", "0 to 20"), (parse_people, "21", "0 to 20"), (parse_people, "two", "an integer"),
+    (parse_rest, "-1", "0 to 60"), (parse_rest, "61", "0 to 60"), (parse_rest, "long", "a number of seconds"),
+])
+def test_a_bad_option_is_refused(parse, text, message):
     with pytest.raises(ValueError, match=message):
-        parse_people(text)
-
-
-@pytest.mark.parametrize(("text", "rest"), [(None, 2.0), ("0", 0.0), ("10", 10.0), ("60", 60.0)])
-def test_the_rest_option_is_seconds(text, rest):
-    assert parse_rest(text) == rest
-
-
-@pytest.mark.parametrize(("text", "message"), [("-1", "0 to 60"), ("61", "0 to 60"), ("long", "a number of seconds")])
-def test_a_bad_rest_is_refused(text, message):
-    with pytest.raises(ValueError, match=message):
-        parse_rest(text)
+        parse(text)
 
 
 def test_a_longer_rest_changes_the_rests_alone(world_file):
