@@ -116,10 +116,9 @@ class Settings:
     """The area's options, checked: people per seed, the variants to run (the method first) and the
     localisations to run each with."""
 
-    people: int = 0  # people in the rooms
+    people: crowd.Crowd = crowd.Crowd()  # people in the rooms
     variants: tuple[str, ...] = DEFAULT_VARIANTS
     localisations: tuple[str, ...] = ("visual",)  # LOCALISATIONS' names, each a set of columns
-    rest: float = crowd.WAIT_S  # s: the most a walking person rests at each end
 
 
 def check_world(world: str) -> FloorGrid:
@@ -150,8 +149,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
         if LOCALISATIONS[name] not in cameras:
             raise ValueError(f"localisation {name} needs the camera {LOCALISATIONS[name]!r}, which world {world!r} "
                              f"does not have (cameras: {', '.join(sorted(cameras))})")
-    return Settings(crowd.parse_people(extra.get(crowd.OPTION)), variants=variants, localisations=names,
-                    rest=crowd.parse_rest(extra.get(crowd.REST_OPTION)))
+    return Settings(crowd.Crowd.from_options(extra), variants=variants, localisations=names)
 
 
 def column(variant: str, localisation: str) -> str:
@@ -168,15 +166,15 @@ def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: f
             for loc in localisations for name in variants for seed in seeds]
 
 
-def seed_worlds(world: str, count: int, seeds: Sequence[int], floor: FloorGrid,
-                folder: Path, rest: float = crowd.WAIT_S) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
-    """Per seed, the world its runs go in (with ``count`` people in the rooms, resting up to ``rest``
-    s: module docstring) and those people; the world itself when there are none."""
-    if not count:
+def seed_worlds(world: str, crowded: crowd.Crowd, seeds: Sequence[int], floor: FloorGrid,
+                folder: Path) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
+    """Per seed, the world its runs go in (with the ``crowded`` people in the rooms: module docstring)
+    and those people; the world itself when there are none."""
+    if not crowded:
         return dict.fromkeys(seeds, world), {}
     loaded = load_world(world)
     start = [(loaded.start.x, loaded.start.y)]
-    people = {seed: crowd.in_rooms(loaded, floor, count, seed, keep_clear=start, rest=rest) for seed in seeds}
+    people = {seed: crowded.in_rooms(loaded, floor, seed, keep_clear=start) for seed in seeds}
     worlds = {seed: str(crowd.world_with_people(world, folder / "people" / f"s{seed:04d}" / f"{Path(world).stem}.yaml",
                                                 people[seed])) for seed in seeds}
     return worlds, people
@@ -383,10 +381,10 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     floor = options.checked[0] if options.checked else check_world(options.world)
     settings = options.checked[1] if options.checked and options.checked[1] is not None else check_options(
         options.world, options.extra)
-    localisations, count = settings.localisations, settings.people
+    localisations = settings.localisations
     world = load_world(options.world)
-    where, people = seed_worlds(options.world, count, options.seeds, floor, Path(options.results_dir).resolve(),
-                                settings.rest)
+    where, people = seed_worlds(options.world, settings.people, options.seeds, floor,
+                                Path(options.results_dir).resolve())
     todo = episodes(where, options.seeds, options.max_time_s, settings.variants, localisations)
     rows = run_sweep(todo, executor=options.executor, results_dir=options.results_dir, timeout_s=options.timeout_s,
                      progress=options.progress, resume=resume)
@@ -423,7 +421,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
             for key in ("map_on_obstacles_m2", "path_length_m"):
                 out[f"{name}_visual_vs_ideal.{key.rsplit('_', 1)[0]}_ratio"] = _ratio(visual.get(key), ideal.get(key))
     out["runs"] = sorted(runs, key=lambda r: (r["variant"], r["seed"]))
-    return {**out, **crowd.figures(people, count, settings.rest)} if count else out
+    return {**out, **settings.people.figures(people)}
 
 
 def format_table(figures: dict[str, Any]) -> str:

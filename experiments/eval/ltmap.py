@@ -124,10 +124,9 @@ class Settings:
     goal_tolerance: float | None  # m; None: per seed from the robot and the map (module docstring)
     rotation: str = "zinf"  # FollowRoute's rotation estimate (ROTATIONS)
     gap_filling: bool = True  # LearnRoute's gap filling (maps.ltmap.gaps)
-    people: int = 0  # people in the repeats' world
+    people: crowd.Crowd = crowd.Crowd()  # people in the repeats' world
     cuts: int | None = None  # at most this many levels cut (None: every level)
     odometry: bool = False  # FollowRoute drives by the taught odometry while lost
-    rest: float = crowd.WAIT_S  # s: the most a walking person rests at each end
 
 
 def check_world(world: str) -> World:
@@ -167,8 +166,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
         if cuts < 0:
             raise ValueError(f"cuts must be >= 0 (0: the full map alone), got {cuts}")
     return Settings(camera, route, min_landmarks, tolerance, rotation, _on_off(extra, "gap_filling"),
-                    crowd.parse_people(extra.get(crowd.OPTION)), cuts, _on_off(extra, "odometry", "off"),
-                    crowd.parse_rest(extra.get(crowd.REST_OPTION)))
+                    crowd.Crowd.from_options(extra), cuts, _on_off(extra, "odometry", "off"))
 
 
 def _on_off(extra: Mapping[str, str], name: str, default: str = "on") -> bool:
@@ -368,8 +366,7 @@ def repeat_worlds(world: str, loaded: World, settings: Settings, seeds: list[int
     if not settings.people:
         return {seed: world for seed in seeds}, {}
     route = settings.route.world_xy
-    people = {seed: crowd.on_ways(loaded, [route], settings.people, seed, keep_clear=[route[0], route[-1]],
-                                  rest=settings.rest)
+    people = {seed: settings.people.on_ways(loaded, [route], seed, keep_clear=[route[0], route[-1]])
               for seed in seeds}
     worlds = {seed: str(crowd.world_with_people(world, folder / "people" / f"s{seed:04d}" / f"{Path(world).stem}.yaml",
                                           people[seed])) for seed in seeds}
@@ -423,7 +420,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         figures = repeat_figures(taught, read_report(folder, episode.id), level, tolerance[episode.seed])
         runs.append({"seed": episode.seed, **figures})
     out = summarise(world, settings, len(options.seeds), teach_rows, failed, runs)
-    return {**out, **crowd.figures(people, settings.people, settings.rest)} if settings.people else out
+    return {**out, **settings.people.figures(people)}
 
 
 def summarise(world: World, settings: Settings, seeds: int, teach_rows: list[dict[str, Any]],

@@ -83,6 +83,37 @@ def parse_rest(text: str | None) -> float:
 
 
 @dataclass(frozen=True)
+class Crowd:
+    """The people an evaluation adds, as its options ask: how many per seed (``people``; 0: none,
+    the episodes as they were) and the most a walking one rests at each end (``rest``)."""
+
+    count: int = 0
+    rest: float = WAIT_S
+
+    @classmethod
+    def from_options(cls, extra: Mapping[str, str]) -> Crowd:
+        """The ``people`` and ``rest`` options, checked; ``ValueError`` with the problem."""
+        return cls(parse_people(extra.get(OPTION)), parse_rest(extra.get(REST_OPTION)))
+
+    def __bool__(self) -> bool:
+        return self.count > 0
+
+    def on_ways(self, world: World, ways: Sequence[np.ndarray], seed: int, *,
+                keep_clear: Sequence[Sequence[float]]) -> list[Walker]:
+        """:func:`on_ways` with this crowd's count and rest."""
+        return on_ways(world, ways, self.count, seed, keep_clear=keep_clear, rest=self.rest)
+
+    def in_rooms(self, world: World, grid: FloorGrid, seed: int, *,
+                 keep_clear: Sequence[Sequence[float]]) -> list[Walker]:
+        """:func:`in_rooms` with this crowd's count and rest."""
+        return in_rooms(world, grid, self.count, seed, keep_clear=keep_clear, rest=self.rest)
+
+    def figures(self, people: dict[int, list[Walker]]) -> dict[str, Any]:
+        """:func:`figures` of the people placed for this crowd (none when it asked for none)."""
+        return figures(people, self.count, self.rest) if self else {}
+
+
+@dataclass(frozen=True)
 class Walker:
     """One person for a world file: where they walk (one point: standing), speed, wait."""
 

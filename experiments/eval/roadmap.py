@@ -114,8 +114,7 @@ class Settings:
     targets: tuple[str, ...]
     starts: int
     source: str = NAMED
-    people: int = 0  # people in the navigations' world
-    rest: float = crowd.WAIT_S  # s: the most a walking person rests at each end
+    people: crowd.Crowd = crowd.Crowd()  # people in the navigations' world
 
 
 @dataclass(frozen=True)
@@ -167,8 +166,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     starts = parse_starts(extra.get("starts"))
     if starts:
         random_starts(loaded, 1, 0, grid=grid)  # ValueError: nowhere clear enough to start from
-    return Settings(targets, starts, source, crowd.parse_people(extra.get(crowd.OPTION)),
-                    crowd.parse_rest(extra.get(crowd.REST_OPTION)))
+    return Settings(targets, starts, source, crowd.Crowd.from_options(extra))
 
 
 def choose_targets(text: str | None, world: World, usable: Mapping[str, Pose2D]) -> tuple[tuple[str, ...], str]:
@@ -282,7 +280,7 @@ def navigation_worlds(loaded: World, settings: Settings, targets: Mapping[int, S
         ways = [np.array([a, b]) for i, a in enumerate(spots) for b in spots[i + 1:]]
         clear = [*spots, (loaded.start.x, loaded.start.y),
                  *((p.x, p.y) for p in random_starts(loaded, settings.starts, seed, grid=grid))]
-        people[seed] = crowd.on_ways(loaded, ways, settings.people, seed, keep_clear=clear, rest=settings.rest)
+        people[seed] = settings.people.on_ways(loaded, ways, seed, keep_clear=clear)
         here = seed_folder(folder, t.world, seed) / "people" / f"{Path(world_path(t.world)).stem}.yaml"
         worlds[seed] = str(crowd.world_with_people(t.world, here, people[seed]))
     return worlds, people
@@ -467,7 +465,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     gotos = [goto_figures(p, read_report(folder, p.episode.id), rows.get(p.episode.id), truth[p.episode.seed][p.goal])
              for p in plans]
     out = summarise(loaded.name, settings, learns, gotos, truth)
-    return {**out, **crowd.figures(people, settings.people, settings.rest)} if settings.people else out
+    return {**out, **settings.people.figures(people)}
 
 
 # ------------------------------------------------------------------------------------------------

@@ -22,6 +22,7 @@ from experiments.eval.exploration import (
     summarise_variant,
     variant_of,
 )
+from experiments.eval.people import Crowd
 from maps.exploration.codec import pack_cells
 from maps.exploration.head import StereoHead, footprint
 from missions.cli import main
@@ -101,9 +102,9 @@ def test_four_variants_per_seed():
 
 
 def test_the_localisation_option_names_the_oracle_beside_the_visual(tmp_path):
-    assert check_options("lab", {}) == Settings(0, localisations=("visual",))
+    assert check_options("lab", {}) == Settings(Crowd(0), localisations=("visual",))
     both = check_options("lab", {"localisation": "visual,ideal", "people": "2"})
-    assert both == Settings(2, localisations=("visual", "ideal"))
+    assert both == Settings(Crowd(2), localisations=("visual", "ideal"))
     with pytest.raises(ValueError, match="visual, ideal or visual,ideal"):
         check_options("lab", {"localisation": "gps"})
     stereo_only = tmp_path / "stereo_only.yaml"
@@ -132,7 +133,7 @@ def test_the_pose_error_is_against_the_truth_in_the_start_frame():
 
 def test_the_variants_option_names_the_runs_and_the_method_always_runs():
     settings = check_options("lab", {"variants": "gaze_before, closest_edges"})
-    assert settings.variants == ("method", "gaze_before", "closest_edges") and settings.people == 0
+    assert settings.variants == ("method", "gaze_before", "closest_edges") and not settings.people
     runs = episodes("lab", [0], variants=settings.variants)
     # the method and gaze_before differ only in the two gaze rules; each run maps back to its own variant
     assert [variant_of(e.inputs) for e in runs] == ["method", "gaze_before", "closest_edges"]

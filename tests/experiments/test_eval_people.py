@@ -16,6 +16,8 @@ from experiments.eval.people import (
     KEEP_CLEAR_M,
     RADIUS,
     SPACING,
+    WAIT_S,
+    Crowd,
     Walker,
     _Placer,
     in_rooms,
@@ -93,8 +95,8 @@ def test_a_longer_rest_changes_the_rests_alone(world_file):
 
 @pytest.mark.parametrize("area", [ltmap, roadmap, exploration])
 def test_every_area_takes_the_rest(area):
-    assert area.check_options("lab", {"people": "3", "rest": "10"}).rest == 10.0
-    assert area.check_options("lab", {"people": "3"}).rest == 2.0
+    assert area.check_options("lab", {"people": "3", "rest": "10"}).people == Crowd(3, 10.0)
+    assert area.check_options("lab", {"people": "3"}).people == Crowd(3, 2.0)
     with pytest.raises(ValueError, match="rest must be 0 to 60"):
         area.check_options("lab", {"rest": "90"})
 
@@ -229,7 +231,7 @@ def test_ltmap_repeats_run_with_people_on_the_route_and_the_teach_without(world_
     path = str(world_file(HALL))
     loaded = load_world(path)
     settings = ltmap.check_options(path, {"people": "3"})
-    assert settings.people == 3
+    assert settings.people.count == 3 and settings.people.rest == WAIT_S
     worlds, people = ltmap.repeat_worlds(path, loaded, settings, [0, 1], tmp_path)
     assert worlds[0] == str(tmp_path / "people" / "s0000" / "world.yaml") and worlds[0] != worlds[1]
     assert len(load_world(worlds[0]).people) == 1 + len(people[0]) and people[0] != people[1]
@@ -241,7 +243,7 @@ def test_ltmap_repeats_run_with_people_on_the_route_and_the_teach_without(world_
     repeat = ltmap.follow_episode(teach, report, ltmap.Level(0, 3, 9, 90, 1000, 1.0), 5, None, world=worlds[0])
     assert repeat.world == worlds[0]
     none = ltmap.check_options(path, {})
-    assert none.people == 0 and ltmap.repeat_worlds(path, loaded, none, [0], tmp_path) == ({0: path}, {})
+    assert not none.people and ltmap.repeat_worlds(path, loaded, none, [0], tmp_path) == ({0: path}, {})
 
 
 def test_roadmap_navigations_run_with_people_between_the_targets(world_file, tmp_path):
@@ -252,7 +254,7 @@ poses:
   c: {x: 8.0, y: 3.0, theta_deg: 180}
 """))
     loaded = load_world(path)
-    settings = roadmap.Settings(("a", "b", "c"), 2, roadmap.NAMED, 4)
+    settings = roadmap.Settings(("a", "b", "c"), 2, roadmap.NAMED, Crowd(4))
     targets = {seed: roadmap.seed_targets(path, loaded, settings, seed, tmp_path) for seed in (0, 1)}
     worlds, people = roadmap.navigation_worlds(loaded, settings, targets, tmp_path, None)
     assert worlds[0] == str(tmp_path / "seeds" / "world_s0000" / "people" / "world.yaml")
@@ -270,7 +272,7 @@ poses:
 
 
 def test_people_zero_leaves_every_episode_as_it_was():
-    assert exploration.seed_worlds("lab", 0, [0, 1], reachable_floor(load_world("lab")), Path("/nowhere")) == (
+    assert exploration.seed_worlds("lab", Crowd(), [0, 1], reachable_floor(load_world("lab")), Path("/nowhere")) == (
         {0: "lab", 1: "lab"}, {})
     assert [e.id for e in exploration.episodes({0: "lab"}, [0])] == [e.id for e in exploration.episodes("lab", [0])]
     teach = Episode("teach_route", "lab", 0, {"map": "m.ltmap", "camera": "landmarks"})
@@ -304,3 +306,11 @@ def test_the_tables_say_how_many_people_were_placed():
     assert table_line({**figures, "people.rest": 10.0}) == [
         "people: 3 asked per seed, standing on or walking across the way, resting up to 10 s at each end (seed 0: "
         "3, seed 1: 2 placed)"]
+
+
+def test_a_crowd_records_its_people_and_nothing_when_it_asked_for_none():
+    walker = Walker(((1.0, 2.0), (1.0, 3.0)), 0.8, 4.5)
+    assert Crowd(2, 5.0).figures({1: [walker], 0: []}) == {
+        "people": 2, "people.rest": 5.0, "people.placed": {"0": 0, "1": 1},
+        "people.paths": {"0": [], "1": [{"path": [[1.0, 2.0], [1.0, 3.0]], "speed": 0.8, "wait_s": 4.5}]}}
+    assert Crowd().figures({}) == {} and not Crowd() and Crowd(1)
