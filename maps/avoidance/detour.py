@@ -75,7 +75,7 @@ the run report's ``avoidance`` section shows.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -138,6 +138,23 @@ class Tally:
     reasons: list[str] = field(default_factory=list)  # why, per give-up
 
 
+@dataclass(frozen=True, slots=True)
+class _HoldEnded:
+    """A hold that stopped without ending (cut short by the node's ending, or left by a back-off):
+    since when it held, when it stopped, where, and its back-offs. A new hold soon after, near there,
+    is the same hold going on (:meth:`goes_on`)."""
+
+    origin: float
+    when: float
+    where: Pose2D
+    backoffs: int = 0
+
+    def goes_on(self, pose: Pose2D, now: float, *, within: float, near: float) -> bool:
+        """Is a hold at ``pose`` now this one going on: within ``within`` s of when it stopped and
+        ``near`` m of where?"""
+        return now - self.when <= within and math.hypot(pose.x - self.where.x, pose.y - self.where.y) <= near
+
+
 @dataclass
 class _Episode:
     """A wait, and the detour it may turn into."""
@@ -172,12 +189,12 @@ class Avoidance:
         self.settings = settings or DetourSettings()
         self.backoff = backoff or BackoffSettings()
         self.trail = Trail(keep=self.backoff.keep)
-        self._backed_from: tuple[float, float, Pose2D, int] | None = None  # (hold's origin, when, where, count)
+        self._backed_from: _HoldEnded | None = None  # the last back-off: its hold, when it ended, where it began
         self.tally = Tally()
         self.phase: Phase = "clear"
         self._episode: _Episode | None = None
         self._pose: Pose2D | None = None  # the last tick's
-        self._cut: tuple[float, float, Pose2D] | None = None  # a hold that reset cut short: (since, when, where)
+        self._cut: _HoldEnded | None = None  # a hold that reset cut short
         self._failed: tuple[Pose2D, float, int] | None = None  # the last detour given up: (where, when, its side)
         self._creeping = False  # the last tick went on at the creep speed
 
@@ -229,7 +246,7 @@ class Avoidance:
         episode = self._episode
         held = None if episode is None else episode.held_since if episode.detour_start is not None else \
             None if self.phase == "clear" else episode.origin
-        self._cut = None if held is None or self._pose is None else (held, now, self._pose)
+        self._cut = None if held is None or self._pose is None else _HoldEnded(held, now, self._pose)
         if episode is not None:
             if episode.detour_start is not None:
                 self._end_detour(episode, now)
@@ -362,7 +379,7 @@ class Avoidance:
         self.trail = trail
         episode.backing, episode.backed, episode.last = target, 0.0, pose
         episode.backoffs += 1
-        self._backed_from = (episode.origin, now, pose, episode.backoffs)
+        self._backed_from = _HoldEnded(episode.origin, now, pose, episode.backoffs)
         self.phase = "backoff"
         self.tally.backoffs += 1
         away = math.hypot(target[0] - pose.x, target[1] - pose.y)
@@ -390,8 +407,7 @@ class Avoidance:
         episode.backing, episode.backed = None, 0.0
         self.phase = "waiting" if episode.detour_start is None else "detour"
         if self._backed_from is not None:  # a hold near here goes on from when the back-off ended
-            origin, _, where, count = self._backed_from
-            self._backed_from = (origin, now, where, count)
+            self._backed_from = replace(self._backed_from, when=now)
         return None
 
     def _other_side(self, pose: Pose2D, now: float) -> int:
@@ -410,12 +426,9 @@ class Avoidance:
         the same hold (its clock and its back-offs go on), so that driving back into the corner and
         backing away again cannot go on for ever."""
         record = self._backed_from
-        if record is None:
-            return
-        origin, when, where, count = record
-        if now - when <= self.settings.timeout and \
-                math.hypot(pose.x - where.x, pose.y - where.y) <= self.backoff.distance + STEP:
-            episode.origin, episode.backoffs = min(episode.origin, origin), count
+        if record is not None and record.goes_on(pose, now, within=self.settings.timeout,
+                                                 near=self.backoff.distance + STEP):
+            episode.origin, episode.backoffs = min(episode.origin, record.origin), record.backoffs
 
     @staticmethod
     def _travelled(episode: _Episode, pose: Pose2D) -> None:
@@ -431,11 +444,7 @@ class Avoidance:
         """When a new hold began: now, or when a hold cut short by the node's ending began, if the
         robot is held again soon after where it stood (module docstring)."""
         cut, self._cut = self._cut, None
-        if cut is None:
-            return now
-        since, when, where = cut
-        near = math.hypot(pose.x - where.x, pose.y - where.y) <= STOOD
-        return since if near and now - when <= RESTART_GAP else now
+        return cut.origin if cut is not None and cut.goes_on(pose, now, within=RESTART_GAP, near=STOOD) else now
 
     def _give_up(self, reason: str, now: float) -> Decision:
         self.reset(now)
