@@ -73,12 +73,14 @@ class Lines:
 
 @dataclass(frozen=True, slots=True)
 class Arrows:
-    """2-D arrows: ``vectors`` (N x 2) from ``origins`` (N x 2, default the frame's origin)."""
+    """2-D arrows: ``vectors`` (N x 2) from ``origins`` (N x 2, default the frame's origin), each with
+    its label (none, or one per arrow)."""
 
     entity: str
     vectors: np.ndarray
     colours: Colour | list[Colour]
     origins: np.ndarray | None = None
+    labels: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)

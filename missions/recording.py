@@ -106,8 +106,9 @@ class Recorder:
                 three = any(np.asarray(s).shape[-1] == 3 for s in strips)
                 kind = rr.LineStrips3D if three else rr.LineStrips2D
                 rr.log(entity, kind(strips, colors=_colours(colours), radii=radius))
-            case Arrows(entity, vectors, colours, origins):
-                rr.log(entity, rr.Arrows2D(vectors=vectors, origins=origins, colors=_colours(colours)))
+            case Arrows(entity, vectors, colours, origins, labels):
+                rr.log(entity, rr.Arrows2D(vectors=vectors, origins=origins, colors=_colours(colours),
+                                           labels=list(labels) or None))
             case Picture(entity, image):
                 self.image(entity, image)
             case Event(entity, text):

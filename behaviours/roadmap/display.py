@@ -9,7 +9,7 @@ degrees, lengths in metres, poses in the reference frame.
 Drawings (the nodes' ``drawings()``, all in the reference frame under ``roadmap/``): ``room``
 (free floor polygon, the obstacle points, the dodecagon corners, the reference), ``coverage``
 (each valid position coloured by the fraction of its headings covered), ``targets`` (position,
-heading; their names on ``targets/labels``), ``graph`` (edges), ``plan`` (the last planned path),
+heading, each labelled with its name), ``graph`` (edges), ``plan`` (the last planned path),
 ``robot`` (the odometry pose seen through the room estimate). The functions here draw a value;
 a node draws it again only when it changed (:class:`Drawn`).
 """
@@ -17,7 +17,6 @@ a node draws it again only when it changed (:class:`Drawn`).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
@@ -94,13 +93,6 @@ class Drawn:
         return True
 
 
-def labelled_arrows(entity: str, origins: np.ndarray, vectors: np.ndarray, colour: Colour,
-                    labels: Iterable[str]) -> list[Drawing]:
-    """Arrows, and their labels on points at their origins (``ENTITY/labels``)."""
-    return [Arrows(entity, vectors, colour, origins),
-            Points(f"{entity}/labels", origins, colour, radius=0.02, labels=tuple(labels))]
-
-
 def room_drawings(room: RoomEstimate) -> list[Drawing]:
     """The free floor polygon (closed), the obstacle points, the dodecagon corners and the reference."""
     loop = np.vstack([room.polygon, room.polygon[:1]])
@@ -110,8 +102,8 @@ def room_drawings(room: RoomEstimate) -> list[Drawing]:
     if room.corners:
         drawings.append(Points("roadmap/room/corners", np.array([[c.x, c.y] for c in room.corners]), CORNER_COLOUR,
                                radius=0.03))
-    drawings += labelled_arrows("roadmap/room/reference", np.array([[0.0, 0.0]]), np.array([[0.4, 0.0]]),
-                                REFERENCE_COLOUR, ["reference"])
+    drawings.append(Arrows("roadmap/room/reference", np.array([[0.4, 0.0]]), REFERENCE_COLOUR, np.array([[0.0, 0.0]]),
+                           labels=("reference",)))
     return drawings
 
 
@@ -131,7 +123,7 @@ def roadmap_drawings(roadmap: Roadmap) -> list[Drawing]:
     if roadmap.targets:
         xy = np.array([[t.pose.x, t.pose.y] for t in roadmap.targets])
         heading = np.array([heading_vector(t.pose) for t in roadmap.targets])
-        drawings += labelled_arrows("roadmap/targets", xy, heading, TARGET_COLOUR, roadmap.names)
+        drawings.append(Arrows("roadmap/targets", heading, TARGET_COLOUR, xy, labels=tuple(roadmap.names)))
     ends = [(roadmap.target(e.source).pose, roadmap.target(e.target).pose) for e in roadmap.edges]
     strips = [np.array([[a.x, a.y], [b.x, b.y]]) for a, b in ends]
     drawings.append(Lines("roadmap/graph", strips, GRAPH_COLOUR, radius=0.015))

@@ -43,7 +43,7 @@ def by_entity(drawings) -> dict[str, object]:
 def test_the_room_is_its_closed_polygon_obstacles_corners_and_the_reference():
     drawn = by_entity(room_drawings(ROOM))
     assert list(drawn) == ["roadmap/room/free", "roadmap/room/obstacles", "roadmap/room/corners",
-                           "roadmap/room/reference", "roadmap/room/reference/labels"]
+                           "roadmap/room/reference"]
     free = drawn["roadmap/room/free"]
     assert isinstance(free, Lines) and free.colours == (40, 160, 40) and free.radius == 0.02
     (loop,) = free.strips
@@ -53,14 +53,12 @@ def test_the_room_is_its_closed_polygon_obstacles_corners_and_the_reference():
     assert np.array_equal(drawn["roadmap/room/corners"].positions, [[1.5, 0.5], [1.7, 0.6]])
     reference = drawn["roadmap/room/reference"]
     assert isinstance(reference, Arrows) and np.array_equal(reference.vectors, [[0.4, 0.0]])
-    assert reference.colours == (200, 60, 200)
-    assert drawn["roadmap/room/reference/labels"].labels == ("reference",)
+    assert reference.colours == (200, 60, 200) and reference.labels == ("reference",)
 
 
 def test_a_room_without_obstacles_or_corners_is_its_polygon_and_the_reference():
     bare = RoomEstimate.from_polygon(ROOM.polygon)
-    assert [d.entity for d in room_drawings(bare)] == ["roadmap/room/free", "roadmap/room/reference",
-                                                       "roadmap/room/reference/labels"]
+    assert [d.entity for d in room_drawings(bare)] == ["roadmap/room/free", "roadmap/room/reference"]
 
 
 def test_coverage_colours_each_valid_position_by_the_fraction_of_headings_covered():
@@ -83,7 +81,7 @@ def test_the_roadmap_is_its_targets_with_headings_and_names_and_its_edges():
     assert isinstance(targets, Arrows) and targets.colours == (230, 140, 0)
     assert np.array_equal(targets.origins, [[1.0, 0.5], [2.0, 1.5]])
     assert targets.vectors[0] == pytest.approx([0.3 * math.cos(0.2), 0.3 * math.sin(0.2)])
-    assert drawn["roadmap/targets/labels"].labels == ("a", "b")
+    assert targets.labels == ("a", "b")
     graph = drawn["roadmap/graph"]
     assert isinstance(graph, Lines) and graph.colours == (30, 90, 220) and graph.radius == 0.015
     assert [s.tolist() for s in graph.strips] == [[[1.0, 0.5], [2.0, 1.5]]]

@@ -69,7 +69,7 @@ def test_drives_the_pair_there_and_back_and_fuses_the_edge(tmp_path):
     assert report_sections(harness.behaviour) == {"roadmap": {
         **roadmap_section(graph), "pairs_tried": 1, "dropped": [], "not_straight": [],
         "homed_short": [], "saved": str(tmp_path / "lab.roadmap")}}
-    assert [d.entity for d in harness.behaviour.drawings()] == ["roadmap/targets", "roadmap/targets/labels",
+    assert [d.entity for d in harness.behaviour.drawings()] == ["roadmap/targets",
                                                                 "roadmap/graph"]
     assert list(harness.behaviour.drawings()) == []  # the same graph: not again
 

@@ -43,7 +43,7 @@ def test_localises_at_a_target_then_follows_the_edge_and_homes_at_the_goal():
     assert report_sections(harness.behaviour) == {"roadmap": {"navigation": {
         "goal": "B", "reached": True, "localised_at": "A", "visited": ["A", "B"], "random_moves": 0, "rescans": 0,
         "homed_short": 0, "reason": ""}}}
-    assert [d.entity for d in harness.behaviour.drawings()] == ["roadmap/targets", "roadmap/targets/labels",
+    assert [d.entity for d in harness.behaviour.drawings()] == ["roadmap/targets",
                                                                 "roadmap/graph"]
     assert list(harness.behaviour.drawings()) == []  # the same roadmap: not again
 

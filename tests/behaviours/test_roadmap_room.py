@@ -84,7 +84,7 @@ def test_reports_the_room_and_draws_it_once_and_the_robot_every_time(estimated):
                                                                   reference.stamp)}}
     assert [d.entity for d in outputs["drawings"]] == [
         "roadmap/room/free", "roadmap/room/obstacles", "roadmap/room/corners", "roadmap/room/reference",
-        "roadmap/room/reference/labels", "roadmap/robot"]
+        "roadmap/robot"]
     assert [d.entity for d in outputs["again"]] == ["roadmap/robot"]
 
 
@@ -103,8 +103,8 @@ def test_reports_whatever_room_is_on_its_output_and_nothing_before():
     image = np.zeros((8, 8), np.uint8)
     harness.write("/map/reference_image", TargetView("reference", image, describe(image), stamp=12.5))
     assert report_sections(node)["roadmap"]["room"]["reference_stamp"] == 12.5
-    assert [d.entity for d in node.drawings()] == ["roadmap/room/free", "roadmap/room/reference",
-                                                   "roadmap/room/reference/labels"]  # no odometry: no robot
+    assert [d.entity for d in node.drawings()] == ["roadmap/room/free",
+                                                   "roadmap/room/reference"]  # no odometry: no robot
 
 
 def test_the_rig_is_mounted_as_its_ports_say():

@@ -129,7 +129,7 @@ def test_record_reports_and_draws_the_roadmap_on_the_blackboard_once_per_roadmap
     harness.write("/map/roadmap", roadmap)
     assert report_sections(harness.behaviour) == {"roadmap": roadmap_section(roadmap)}
     drawn = [d.entity for d in harness.behaviour.drawings()]
-    assert drawn == ["roadmap/targets", "roadmap/targets/labels", "roadmap/graph"]
+    assert drawn == ["roadmap/targets", "roadmap/graph"]
     assert list(harness.behaviour.drawings()) == []  # the same roadmap: not again
 
 

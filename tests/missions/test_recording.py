@@ -41,7 +41,7 @@ class _Node:
         yield Points("a/points2d", np.zeros((3, 2)), colours=(1, 2, 3))
         yield Points("a/points3d", np.zeros((3, 3)), colours=[(1, 2, 3)] * 3, labels=("x", "y", "z"))
         yield Lines("a/lines", [np.zeros((2, 2))], colours=(0, 0, 0))
-        yield Arrows("a/arrows", np.ones((1, 2)), colours=(9, 9, 9))
+        yield Arrows("a/arrows", np.ones((1, 2)), colours=(9, 9, 9), labels=("north",))
         yield Picture("a/picture", np.zeros((2, 2, 3), np.uint8))
         yield Event("a/events", "hello")
         yield Plot("a/plot", 0.5)
@@ -61,8 +61,8 @@ def test_every_drawing_becomes_its_archetype():
     assert kinds == {"figures/ltmap/search/scans": "Scalars", "a/points2d": "Points2D", "a/points3d": "Points3D",
                      "a/lines": "LineStrips2D", "a/arrows": "Arrows2D", "a/picture": "EncodedImage",
                      "a/events": "TextLog", "a/plot": "Scalars"}
-    labels = next(kwargs["labels"] for entity, _, kwargs in fake.logged if entity == "a/points3d")
-    assert labels == ["x", "y", "z"]
+    labels = {entity: kwargs["labels"] for entity, _, kwargs in fake.logged if entity in ("a/points3d", "a/arrows")}
+    assert labels == {"a/points3d": ["x", "y", "z"], "a/arrows": ["north"]}
 
 
 def test_a_figure_is_plotted_only_when_it_changes():
