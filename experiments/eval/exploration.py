@@ -166,15 +166,15 @@ def episodes(world: str | Mapping[int, str], seeds: Sequence[int], max_time_s: f
             for loc in localisations for name in variants for seed in seeds]
 
 
-def seed_worlds(world: str, crowded: crowd.Crowd, seeds: Sequence[int], floor: FloorGrid,
+def seed_worlds(world: str, asked: crowd.Crowd, seeds: Sequence[int], floor: FloorGrid,
                 folder: Path) -> tuple[dict[int, str], dict[int, list[crowd.Walker]]]:
-    """Per seed, the world its runs go in (with the ``crowded`` people in the rooms: module docstring)
-    and those people; the world itself when there are none."""
-    if not crowded:
+    """Per seed, the world its runs go in (with the people ``asked`` for in the rooms: module docstring)
+    and those people; the world itself when none were."""
+    if not asked:
         return dict.fromkeys(seeds, world), {}
     loaded = load_world(world)
     start = [(loaded.start.x, loaded.start.y)]
-    people = {seed: crowded.in_rooms(loaded, floor, seed, keep_clear=start) for seed in seeds}
+    people = {seed: asked.in_rooms(loaded, floor, seed, keep_clear=start) for seed in seeds}
     worlds = {seed: str(crowd.world_with_people(world, folder / "people" / f"s{seed:04d}" / f"{Path(world).stem}.yaml",
                                                 people[seed])) for seed in seeds}
     return worlds, people
