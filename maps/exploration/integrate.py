@@ -40,6 +40,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy import ndimage
 
 from maps.exploration.grid import EvidenceParams, ExplorationMap, GridFrame, covering
 from maps.exploration.head import CameraView, footprint
@@ -68,6 +69,8 @@ class IntegrationParams:
     max_edge_px: float = 12.0  # image neighbours: pixels this close (~1.5 x the step of dense points; ~40 sparse)
     scan_bin: float = math.radians(1.0)  # azimuth bins of the virtual range scan
     see_past: float = 0.3  # m: cells this far or more before the end of a bin's free floor are seen past
+    echo_top: float = 0.5  # m: the highest a range echo speaks for (a sonar passes under a table top)
+    echo_near: float = 0.1  # m: ... an obstacle point this near a cell, up to echo_top, lets an echo clear it
     evidence: EvidenceParams = EvidenceParams()
     grow_chunk: float = 4.0  # m: the grid grows by multiples of this
     interest: InterestParams = InterestParams()
@@ -169,7 +172,12 @@ def clear_rays(
 
     Why: the cameras see nothing within ~0.66 m of the lens; a person who walked past the robot
     close by stayed in the map round it as obstacle cells no view could see past, and in one
-    office run every path out of a room corner was blocked by them for 240 s."""
+    office run every path out of a room corner was blocked by them for 240 s.
+
+    Not what hangs above the sensors: a cell whose stored obstacle points all lie higher than
+    ``echo_top``, with none up to that height within ``echo_near`` of it (a table top, a shelf, a
+    counter's overhang), stays: a sonar's beam passes under it, and clearing it would send the
+    robot's mast into it."""
     f = m.frame
     starts = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
     stops = np.asarray(ends, dtype=np.float64).reshape(-1, 2)
@@ -190,9 +198,35 @@ def clear_rays(
     held = m.evidence[r, c] > 0.0
     if not held.any():
         return m
+    held[held] = ~_overhangs(m, r[held], c[held], params)
+    if not held.any():
+        return m
     evidence = m.evidence.copy()
     evidence[r[held], c[held]] -= params.evidence.past
     return m.replaced(evidence=evidence)
+
+
+def _overhangs(m: ExplorationMap, rows: np.ndarray, cols: np.ndarray, params: IntegrationParams) -> np.ndarray:
+    """Which of the cells (``rows``, ``cols``) hold stored obstacle points only above ``echo_top``,
+    with no obstacle point up to that height within ``echo_near``: what a range echo cannot speak for."""
+    out = np.zeros(len(rows), dtype=bool)
+    if not len(m.points) or not len(rows):
+        return out
+    reach = int(math.ceil(params.echo_near / m.frame.resolution))
+    top, left = rows.min() - reach, cols.min() - reach  # a window round the cells, wide enough for the reach
+    shape = (int(rows.max() - top) + reach + 1, int(cols.max() - left) + reach + 1)
+    pr, pc = m.frame.cell_of(m.points[:, :2])
+    pr, pc, z = pr - top, pc - left, m.points[:, 2]
+    near = (pr >= 0) & (pr < shape[0]) & (pc >= 0) & (pc < shape[1])
+    near &= (z > params.floor_tolerance) & (z <= params.obstacle_height)  # obstacle points round the cells
+    if not near.any():
+        return out
+    high, low = np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool)
+    above = z > params.echo_top
+    high[pr[near & above], pc[near & above]] = True
+    low[pr[near & ~above], pc[near & ~above]] = True
+    low = ndimage.binary_dilation(low, structure=np.ones((2 * reach + 1, 2 * reach + 1), dtype=bool))
+    return high[rows - top, cols - left] & ~low[rows - top, cols - left]
 
 
 def scan(

@@ -179,3 +179,24 @@ def test_an_echo_clears_the_obstacle_cells_before_it_and_explores_nothing():
     assert state_at(m, 0.55, 0.55) == Cell.OBSTACLE  # off the axis
     assert m.evidence[m.frame.cell_of(np.array([[0.25, 0.05]]))][0] == pytest.approx(-1.0)
     assert state_at(m, 1.35, 0.05) == Cell.UNKNOWN  # the sonar explores nothing
+
+
+def test_an_echo_does_not_clear_what_hangs_above_the_sonar():
+    # cells 0.5 m, 0.8 m and 1.05 m ahead hold obstacle evidence; the stereo's stored points there: a
+    # table top's edge (0.72 m, nothing lower near it), a person (1.5 m and, 0.07 m off, 0.3 m), and a
+    # person seen only at 1.2 m but with their legs 0.3 m up in the next cell (0.1 m off)
+    m = ExplorationMap.empty(resolution=0.05)
+    evidence = m.evidence.copy()
+    ahead = np.array([[0.525, 0.025], [0.825, 0.025], [1.075, 0.025], [0.325, 0.025]])
+    evidence[m.frame.cell_of(ahead)] = 3.5
+    points = np.array([[0.53, 0.02, 0.72],                      # the table top, alone
+                       [0.83, 0.02, 1.5], [0.83, 0.09, 0.3],     # a person: head, and legs 0.07 m off
+                       [1.07, 0.02, 1.2], [1.17, 0.02, 0.3],     # high here, low 0.1 m on
+                       [0.33, 0.02, 1.4]])                       # a shelf, 1.4 m up: above obstacle_height
+    m = clear_rays(m.replaced(evidence=evidence, points=points), np.array([[0.0, 0.025]]), np.array([[1.6, 0.025]]))
+    assert state_at(m, 0.525, 0.025) == Cell.OBSTACLE  # the sonar passed under the table top
+    assert state_at(m, 0.825, 0.025) == Cell.FREE and state_at(m, 1.075, 0.025) == Cell.FREE
+    assert state_at(m, 0.325, 0.025) == Cell.FREE  # points above obstacle_height are no obstacle at all
+    lower = clear_rays(m.replaced(evidence=evidence, points=points * [1.0, 1.0, 0.5]), np.array([[0.0, 0.025]]),
+                       np.array([[1.6, 0.025]]))
+    assert state_at(lower, 0.525, 0.025) == Cell.FREE  # the same at 0.36 m: the sonar hears it, and saw past
