@@ -109,8 +109,13 @@ class Crowd:
         return in_rooms(world, grid, self.count, seed, keep_clear=keep_clear, rest=self.rest)
 
     def figures(self, people: dict[int, list[Walker]]) -> dict[str, Any]:
-        """:func:`figures` of the people placed for this crowd (none when it asked for none)."""
-        return figures(people, self.count, self.rest) if self else {}
+        """What the evaluation records of the people placed for this crowd: how many were asked for,
+        their longest rest, placed per seed, and where (none when it asked for none)."""
+        if not self:
+            return {}
+        return {"people": self.count, "people.rest": self.rest,
+                "people.placed": {str(seed): len(walkers) for seed, walkers in sorted(people.items())},
+                "people.paths": {str(seed): [w.entry() for w in walkers] for seed, walkers in sorted(people.items())}}
 
 
 @dataclass(frozen=True)
@@ -327,14 +332,6 @@ def world_with_people(world: str | Path, out: Path, people: Sequence[Walker]) ->
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(yaml.safe_dump(data, sort_keys=False))
     return out
-
-
-def figures(people: dict[int, list[Walker]], asked: int, rest: float = WAIT_S) -> dict[str, Any]:
-    """What the evaluation records of its people: how many were asked for, their longest rest, placed
-    per seed, and where."""
-    return {"people": asked, "people.rest": rest,
-            "people.placed": {str(seed): len(walkers) for seed, walkers in sorted(people.items())},
-            "people.paths": {str(seed): [w.entry() for w in walkers] for seed, walkers in sorted(people.items())}}
 
 
 def table_line(figures: Mapping[str, Any]) -> list[str]:
