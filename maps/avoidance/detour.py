@@ -25,13 +25,19 @@ the robot's odometry. Three phases:
   path by itself. A wish to stop or to back away passes (the collision monitor judges it). Where
   the wish heads is kept in the odometry frame from its last forward command, so that a wish to
   turn on the spot (which says only which way) does not swing the choice as the robot turns (a
-  turn on the spot the other way from the remembered heading replaces it: :meth:`Avoidance._wish`). A
-  hold whose wish was a turn on the spot when first judged (the node means to face something
-  beyond the fan's edge: a new goal behind the robot) takes no direction more than
-  :data:`FACING` from that edge, and with none backs away (below): driving on the other way takes
-  the robot away from where it turns to (in `flat`'s exploration the monitor stopped the robot at
-  the mouth of a slot between a bed and a wall as a goal 13 m behind it was chosen; the only free
-  direction was straight on, and the detour drove 1 m into the slot, where the robot stayed). So
+  turn on the spot the other way from the remembered heading replaces it: :meth:`Avoidance._wish`).
+  No direction more than :data:`FACING` (a right angle) from the wish is taken; with none the robot
+  is held and backs away (below): a direction farther round drives away from where the node
+  heads, which is going back, not round. A hold whose wish is a turn on the spot (the node means
+  to face something beyond the fan's edge: a new goal behind the robot) is measured from that
+  edge (in `flat`'s exploration the monitor stopped the robot at the mouth of a slot between a bed
+  and a wall as a goal 13 m behind it was chosen; the only free direction was straight on, and the
+  detour drove 1 m into the slot, where the robot stayed). Until stop 45 the bound held only for
+  such a hold, and a detour whose wish had swung round as the robot turned took any direction on
+  its side: in the office with 3 more people, a detour started to the right of a pacer; as it
+  turned the robot right, the route's viewframe came to lie 90-145 degrees to the left, and the
+  detour went on taking the free directions on its right, 120-140 degrees from the wish, driving
+  0.6 m north-east, away from home, where the trail was lost. So
   a wish to turn on the spot towards a goal (``reach``) nearer than anything sensed (every point
   farther from the robot's centre than the goal and the footprint's farthest corner together)
   ends the detour at once: the detour took the robot beside its goal (past a person, to a
@@ -93,7 +99,7 @@ RESTART_GAP = 2.0  # s: a hold cut short by the node's ending goes on when held 
 STOOD = 0.05  # m: ... this close to where it was held
 PROGRESS = 0.1  # m: a detour that has not moved this far from where it was for ``timeout`` s got nowhere
 CREEP = 0.1  # m/s: a wish held only by the margin beside its way goes on this slowly, where that is open
-FACING = math.pi / 2.0  # rad: a hold whose wish is a turn on the spot takes no direction farther than this from it
+FACING = math.pi / 2.0  # rad: a detour takes no direction farther than this from the wish
 
 
 @dataclass(frozen=True, slots=True)
@@ -177,7 +183,6 @@ class _Episode:
     backed: float = 0.0  # m backed in the current back-off
     beyond: float = 0.0  # m a direction must be free for after a back-off: past where the robot was wedged
     anchor: tuple[float, Pose2D] | None = None  # (since, where): the detour has not moved PROGRESS from there since
-    facing: bool = False  # the wish was a turn on the spot when first judged: the node faces beyond the fan's edge
 
 
 class Avoidance:
@@ -281,7 +286,7 @@ class Avoidance:
         if held < self.settings.wait:
             return Decision(0.0, 0.0, "waiting")
         choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode), pose=pose,
-                        line=episode.line, side=self._other_side(pose, now), within=self._within(episode))
+                        line=episode.line, side=self._other_side(pose, now), within=FACING)
         if choice.direction is not None:
             self._end_wait(episode, now, cleared=False)
             episode.detour_start, episode.last, episode.side = now, pose, choice.side
@@ -318,7 +323,7 @@ class Avoidance:
             return Decision(v, w, "detour", passed=True)
         episode.clear_since = None
         choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode),
-                        side=episode.side, pose=pose, line=episode.line, within=self._within(episode))
+                        side=episode.side, pose=pose, line=episode.line, within=FACING)
         command = steer(choice, around, self.avoid)
         if choice.direction is not None and not stopped and command != (0.0, 0.0):
             episode.held_since = None
@@ -536,15 +541,7 @@ class Avoidance:
         through a door into a room, where the trail was lost)."""
         if v > 0.0 or episode.goal is None or _turns_away(episode.goal, pose, v, w):
             episode.goal = pose.theta + wished_direction(v, w, self.avoid)
-            episode.facing = v <= 0.0
         return float(np.clip(wrap_angle(episode.goal - pose.theta), -self.avoid.spread, self.avoid.spread))
-
-    @staticmethod
-    def _within(episode: _Episode) -> float:
-        """How far from the wish a direction may be (rad): :data:`FACING` while the wish stands for a
-        turn on the spot (the node means to face beyond the fan's edge: a direction on the other side
-        of straight ahead drives away from it), any distance for a wish that drives."""
-        return FACING if episode.facing else math.inf
 
     def _reach(self, v: float, episode: _Episode | None = None) -> float:
         """How far a detour's direction must be free: as far as the detour's speed needs, or the wish's,

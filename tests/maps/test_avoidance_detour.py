@@ -322,6 +322,26 @@ def test_a_turn_on_the_spot_away_from_the_remembered_heading_replaces_it():
         -np.radians(120.0) + 0.3)  # the new heading is remembered: it does not swing as the robot turns
 
 
+def test_a_detour_takes_no_direction_more_than_a_right_angle_from_the_wish():
+    """A detour started to the right of something ahead and on its left (-40 degrees, the free
+    direction nearest straight on). The robot has since turned 100 degrees right, and the node
+    turns on the spot back to the left: where it heads lies 100 degrees left now. The free
+    directions are straight on and to the right, 100 degrees or more from the wish, on the
+    detour's side: taking them drives away from where the node heads (the office's pacer, stop
+    45), so none is taken and the robot is held."""
+    a = avoidance(wait=0.0)
+    ahead_left = np.array([[0.6, 0.0], [0.55, 0.2], [0.5, 0.35]])
+    a.step(0.3, 0.0, ahead_left, HERE, 0.0)
+    started = a.step(0.3, 0.0, ahead_left, HERE, 0.1)
+    assert started.phase == "detour" and started.choice is not None and started.choice.side == -1
+    assert started.choice.direction is not None and started.choice.direction.angle == pytest.approx(np.radians(-40.0))
+    left = np.radians(np.arange(10.0, 125.0, 5.0))
+    wall_on_the_left = 0.45 * np.column_stack((np.cos(left), np.sin(left)))
+    turned = a.step(0.0, 0.8, wall_on_the_left, Pose2D(0.0, 0.0, np.radians(-100.0)), 0.2)
+    assert turned.choice is not None and turned.choice.wish == pytest.approx(np.radians(100.0))
+    assert turned.choice.direction is None and (turned.v, turned.w) == (0.0, 0.0) and turned.phase == "detour"
+
+
 def test_a_wish_held_only_by_the_margin_beside_its_way_creeps_on():
     """In a doorway (jambs 0.16 m either side of the disc) a wish curving left is held by the clearance,
     not by the jambs themselves: the footprint goes as far as it means to go and the margin farther.
