@@ -36,7 +36,7 @@ the robot's odometry. Three phases:
   such a hold, and a detour whose wish had swung round as the robot turned took any direction on
   its side: in the office with 3 more people, a detour started to the right of a pacer; as it
   turned the robot right, the route's viewframe came to lie 90-145 degrees to the left, and the
-  detour went on taking the free directions on its right, 120-140 degrees from the wish, driving
+  detour went on taking the free directions on its right, 100-135 degrees from the wish, driving
   0.6 m north-east, away from home, where the trail was lost. So
   a wish to turn on the spot towards a goal (``reach``) nearer than anything sensed (every point
   farther from the robot's centre than the goal and the footprint's farthest corner together)
