@@ -196,8 +196,6 @@ def clear_rays(
         return m
     r, c = np.divmod(cells, f.cols)
     held = m.evidence[r, c] > 0.0
-    if not held.any():
-        return m
     held[held] = ~_overhangs(m, r[held], c[held], params)
     if not held.any():
         return m
