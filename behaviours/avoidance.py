@@ -98,6 +98,9 @@ class AvoidObstacles(BearingsDecorator):
                         doc="no direction will do: back away this far along the way the robot came (0: never)")
     PASS_TURNS = InputPort("pass_turns", bool, False, literal_only=True,
                            doc="a wish to turn on the spot passes in every phase (a child turning by a measured angle)")
+    UNDO = InputPort("undo", bool, False, literal_only=True,
+                     doc="held on a detour with no direction: back along the detour's own way (however 'backoff' "
+                         "is set), then try the other side")
     GOING_ROUND = InputPort("going_round", bool, True, literal_only=True,
                             doc="give up a detour that has turned 180 deg (it goes round what the child heads for); "
                                 "false for a child whose own path turns (a search pattern)")
@@ -113,7 +116,7 @@ class AvoidObstacles(BearingsDecorator):
                       doc="true while it holds the robot for the way to clear by itself (the first 'wait' seconds)")
     RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
     PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, BACKOFF, PASS_TURNS,
-             GOING_ROUND, MEMORY, ROBOT_RADIUS, FOOTPRINT, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
+             UNDO, GOING_ROUND, MEMORY, ROBOT_RADIUS, FOOTPRINT, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
@@ -174,7 +177,7 @@ class AvoidObstacles(BearingsDecorator):
         return Avoidance(settings, DetourSettings(
             wait=self.get_input(self.WAIT), timeout=self.get_input(self.TIMEOUT),
             max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS),
-            going_round=self.get_input(self.GOING_ROUND)),
+            going_round=self.get_input(self.GOING_ROUND), undo=self.get_input(self.UNDO)),
             BackoffSettings(distance=self.get_input(self.BACKOFF)))
 
     def terminate(self, new_status: Status) -> None:

@@ -59,6 +59,16 @@ near where it began, is the same hold (its clock and back-offs go on), so drivin
 backing out cannot go on for ever. The timeout counts on through back-offs, and ends one that
 is still going ("backing away 0.20 m did not free the way").
 
+Undoing a detour (``undo``): where a detour held with no direction would give up (its
+``timeout``), it backs along its own way instead, as far as it went (up to the trail kept),
+whatever ``distance`` says, once (not a detour shorter than
+:data:`~maps.avoidance.backoff.MIN_BACK`: it led nowhere), and then takes the other side of the
+wish, giving up ``wait`` seconds later when no direction will do there either: the side it took
+led into a wedge (in the lab, between a pillar and a person standing on the route, where the
+robot stood for 200 s, losing 20 s at a time to a give-up, a skip that saw nothing farther and a
+search that found the trail where it stood). Not sooner: a wedge a walking person makes opens by
+itself.
+
 Giving up (FAILURE, with a reason, so the mission's recovery takes over): held, waiting or
 without a direction, for ``timeout`` seconds (a hold the motion node's ending cut short, a route
 follower losing the trail for a moment, goes on counting when the node starts again within
@@ -86,7 +96,7 @@ from typing import Literal
 
 import numpy as np
 
-from maps.avoidance.backoff import STEP, BackoffSettings, Trail, back_command
+from maps.avoidance.backoff import MIN_BACK, STEP, BackoffSettings, Trail, back_command
 from maps.avoidance.directions import Choice, choose, steer, wished_direction
 from maps.avoidance.sweep import AvoidSettings, DetourLine, Surroundings, free_distance, needed_distance
 from perception.geometry import Pose2D, wrap_angle
@@ -112,6 +122,7 @@ class DetourSettings:
     max_length: float = 6.0  # m: a detour this long that has not got past gives up
     pass_turns: bool = False  # a wish to turn on the spot passes in every phase (nodes that turn by a measured angle)
     going_round: bool = True  # a detour turned by GOING_ROUND gives up (off for nodes whose own path turns)
+    undo: bool = False  # held on a detour with no direction: back along the detour's own way, then the other side
 
 
 @dataclass(frozen=True, slots=True)
@@ -181,7 +192,10 @@ class _Episode:
     backoffs: int = 0  # back-offs in this hold; after one the wait lasts until a detour starts
     backing: tuple[float, float] | None = None  # the trail point backed to (odometry), while backing
     backed: float = 0.0  # m backed in the current back-off
+    back_limit: float = 0.0  # m the current back-off was asked for (it backs at most twice that)
     beyond: float = 0.0  # m a direction must be free for after a back-off: past where the robot was wedged
+    undoing: bool = False  # the back-off going on undoes the detour (``undo``): the other side after it
+    undone: bool = False  # the detour was undone once (an episode undoes once)
     anchor: tuple[float, Pose2D] | None = None  # (since, where): the detour has not moved PROGRESS from there since
 
 
@@ -329,8 +343,9 @@ class Avoidance:
             episode.held_since = None
         else:  # no direction will do, none that moves the robot, or the monitor stopped the last command: held
             episode.held_since = now if episode.held_since is None else episode.held_since
-            backing = self._start_back(episode, choice, around, pose, now) \
-                if now - episode.held_since >= self.settings.wait else None
+            held = now - episode.held_since
+            backing = self._start_back(episode, choice, around, pose, now, timed_out=held >= self.settings.timeout) \
+                if held >= self.settings.wait else None
             if backing is not None:
                 return backing
             if now - episode.held_since >= self.settings.timeout:
@@ -369,20 +384,26 @@ class Avoidance:
             return f"the detour got nowhere for {now - episode.anchor[0]:.0f} s (within {PROGRESS:g} m)"
         return ""
 
-    def _start_back(self, episode: _Episode, choice: Choice, around: Surroundings, pose: Pose2D, now: float
-                    ) -> Decision | None:
+    def _start_back(self, episode: _Episode, choice: Choice, around: Surroundings, pose: Pose2D, now: float,
+                    *, timed_out: bool = False) -> Decision | None:
         """No direction will do for the obstacles around: back away along the trail
         (:mod:`maps.avoidance.backoff`), if this hold has not done so :data:`BACKOFFS_PER_HOLD` times,
         the trail goes back far enough and the way back is free. Not when free directions stray too far
-        (the bound holds the robot, not an obstacle)."""
-        if self.backoff.distance <= 0.0 or episode.backoffs >= BACKOFFS_PER_HOLD or choice.only_straying:
+        (the bound holds the robot, not an obstacle). A detour's hold that has ``timed_out`` is undone
+        instead, with ``undo``: back along the detour's own way, once (module docstring)."""
+        undo = timed_out and self.settings.undo and episode.detour_start is not None and not episode.undone \
+            and episode.length >= MIN_BACK  # a detour that hardly moved led nowhere: nothing to undo
+        distance = min(episode.length, self.backoff.keep) if undo else self.backoff.distance
+        if distance <= 0.0 or (episode.backoffs >= BACKOFFS_PER_HOLD and not undo) or choice.only_straying:
             return None
-        target, trail = self.trail.target(pose, self.backoff.distance)
+        target, trail = self.trail.target(pose, distance)
         command = None if target is None else back_command(target, pose, around, self.avoid, self.backoff)
         if target is None or command is None:
             return None
         self.trail = trail
-        episode.backing, episode.backed, episode.last = target, 0.0, pose
+        episode.backing, episode.backed, episode.last, episode.back_limit = target, 0.0, pose, distance
+        if undo:  # the undo is a hold of its own: the one that timed out led into the wedge
+            episode.undoing, episode.undone, episode.held_since = True, True, now
         episode.backoffs += 1
         self._backed_from = _HoldEnded(episode.origin, now, pose, episode.backoffs)
         self.phase = "backoff"
@@ -403,13 +424,16 @@ class Avoidance:
                                  "free the way", now)
         tx, ty = episode.backing
         command = None
-        if math.hypot(tx - pose.x, ty - pose.y) > STEP and episode.backed < 2.0 * self.backoff.distance:
+        if math.hypot(tx - pose.x, ty - pose.y) > STEP and episode.backed < 2.0 * episode.back_limit:
             command = back_command(episode.backing, pose, around, self.avoid, self.backoff)
         if command is not None:
             return Decision(*command, "backoff")
         self.tally.backoff_length += episode.backed
         episode.beyond = episode.backed + needed_distance(self.avoid.speed, self.avoid)
         episode.backing, episode.backed = None, 0.0
+        if episode.undoing:  # the side the detour took led into a wedge: the other, or give up after a wait
+            episode.undoing, episode.side = False, -episode.side
+            episode.held_since = now - max(0.0, self.settings.timeout - self.settings.wait)
         self.phase = "waiting" if episode.detour_start is None else "detour"
         if self._backed_from is not None:  # a hold near here goes on from when the back-off ended
             self._backed_from = replace(self._backed_from, when=now)

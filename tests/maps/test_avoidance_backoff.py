@@ -178,3 +178,111 @@ def test_held_while_the_wish_turns_round_it_backs_out_of_a_slot_rather_than_driv
     b.step(0.2, 0.0, SLOT, pose, t, stopped=True)
     ahead = b.step(0.2, 0.0, SLOT, pose, t + 2.0)
     assert ahead.phase == "detour" and ahead.v > 0.0
+
+
+# A person 0.75 m ahead of the route's line (+x from the origin, odometry), their outline every 10 deg.
+PERSON_AHEAD = np.array([[0.75 + 0.25 * math.cos(a), 0.25 * math.sin(a)] for a in np.radians(np.arange(0, 360, 10))])
+
+
+def _wedge(at: np.ndarray) -> np.ndarray:
+    """Points 0.45 m round ``at`` (odometry) from -90 to +60 deg of +x: nothing within 90 deg of the
+    route's heading is free there (0.19 m from the disc, less than the 0.18 m a detour needs plus the
+    clearance), only the way back, 120 deg."""
+    return np.array([at + 0.45 * np.array([math.cos(a), math.sin(a)]) for a in np.radians(np.arange(-90, 61, 10))])
+
+
+def _detour_into_a_wedge(a: Avoidance, length: float = 0.4) -> tuple[float, Pose2D, int, np.ndarray]:
+    """Drive up to the person, wait, detour ``length`` m the way the detour chose, where a wedge closes
+    in (someone stepping up beside the person); returns the time, the pose, the side and the world points."""
+    t = drive_in(a)
+    here = Pose2D()
+    assert a.step(0.3, 0.0, seen_of(PERSON_AHEAD, here), here, t).phase == "waiting"
+    start = a.step(0.3, 0.0, seen_of(PERSON_AHEAD, here), here, t + 2.0)
+    assert start.phase == "detour" and start.choice is not None and start.choice.direction is not None
+    side, psi = start.choice.side, start.choice.direction.angle
+    now, pose = t + 2.0, here
+    for s in np.arange(0.02, length + 0.01, 0.02):  # the robot drives the chosen direction, the node wishing back
+        now += 0.1
+        pose = Pose2D(float(s * math.cos(psi)), float(s * math.sin(psi)), psi)
+        assert a.step(0.0, -side * 0.5, seen_of(PERSON_AHEAD, pose), pose, now).phase == "detour"
+    world = np.vstack((PERSON_AHEAD, _wedge(np.array([pose.x, pose.y]))))
+    return now, pose, side, world
+
+
+def seen_of(world: np.ndarray, pose: Pose2D) -> np.ndarray:
+    return np.asarray(parent_to_frame(pose, world))
+
+
+def test_a_detour_wedged_on_its_way_round_is_undone_and_the_other_side_taken():
+    """``undo``: held on a detour with nothing free within 90 deg of the route (in the lab a detour
+    went between a pillar and a person standing on the route and stood there for 200 s), the robot
+    drives back the way the detour came, as far as the detour went, even with back-offs off
+    (``backoff: 0``, the route's: a wait for a person does not back away), then takes the other side.
+    It does so where it would give up, at the hold's timeout: a wedge that a walking person makes
+    opens by itself (in the lab's seed 7 undoing after the 2 s wait lost a repeat that waiting got home)."""
+    a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0, undo=True), BackoffSettings(distance=0.0))
+    now, pose, side, world = _detour_into_a_wedge(a)
+    held = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 0.1)
+    assert (held.phase, held.v, held.w) == ("detour", 0.0, 0.0) and held.choice is not None
+    assert held.choice.direction is None  # nothing within 90 deg of the route
+    for t in np.arange(now + 0.5, now + 20.0, 0.5):  # held: a person beside it may yet walk on
+        d = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, float(t))
+        assert (d.phase, d.v, d.w) == ("detour", 0.0, 0.0)
+    back = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 20.2)  # held for the timeout: undone
+    assert back.phase == "backoff" and back.v < 0.0 and not back.gave_up
+    assert back.event == "no way round: backing away 0.40 m the way it came"
+    now += 20.2
+    for f in np.arange(0.95, 0.0, -0.05):  # back along the detour to where it began
+        now += 0.2
+        pose = Pose2D(pose.x * f / (f + 0.05), pose.y * f / (f + 0.05), pose.theta)
+        step = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now)
+        if step.phase != "backoff":
+            break
+    pose = Pose2D(0.0, 0.0, pose.theta)
+    after = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 0.2)
+    assert a.tally.backoffs == 1 and a.tally.backoff_length == pytest.approx(0.4, abs=0.03)
+    assert after.phase == "detour" and after.choice is not None and after.choice.direction is not None
+    assert after.choice.side == -side  # the other side of the person
+
+
+def test_without_undo_the_wedged_detour_stays_held_with_back_offs_off_and_gives_up():
+    a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0), BackoffSettings(distance=0.0))
+    now, pose, side, world = _detour_into_a_wedge(a)
+    for t in np.arange(now + 0.1, now + 20.0, 0.5):
+        d = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, float(t))
+        assert (d.phase, d.v, d.w) == ("detour", 0.0, 0.0)
+    assert a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 20.2).gave_up.startswith("blocked for 20 s")
+    assert a.tally.backoffs == 0
+
+
+def test_an_undone_detour_held_on_the_other_side_too_gives_up_after_the_wait():
+    """Undoing is one more chance, not a new hold: with no way on the other side either, it gives up
+    ``wait`` seconds after it is back, not ``timeout`` seconds."""
+    a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0, undo=True), BackoffSettings(distance=0.0))
+    now, pose, side, world = _detour_into_a_wedge(a)
+    for t in np.arange(now + 0.1, now + 20.0, 0.5):  # held from now + 0.1
+        a.step(0.0, -side * 0.5, seen_of(world, pose), pose, float(t))
+    now += 20.2
+    assert a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now).phase == "backoff"
+    for f in np.arange(0.95, 0.0, -0.05):
+        now += 0.2
+        pose = Pose2D(pose.x * f / (f + 0.05), pose.y * f / (f + 0.05), pose.theta)
+        if a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now).phase != "backoff":
+            break
+    pose = Pose2D(0.0, 0.0, pose.theta)
+    boxed = np.vstack((world, _wedge(np.zeros(2)), _wedge(np.zeros(2)) * [1.0, -1.0]))  # nothing free here now
+    held = a.step(0.0, -side * 0.5, seen_of(boxed, pose), pose, now + 0.2)
+    assert (held.phase, held.v, held.w, held.gave_up) == ("detour", 0.0, 0.0, "")
+    d = a.step(0.0, -side * 0.5, seen_of(boxed, pose), pose, now + 2.2)
+    assert d.gave_up.startswith("blocked for 20 s") and a.tally.give_ups == 1
+
+
+def test_a_detour_that_hardly_moved_is_not_undone_it_gives_up_as_before():
+    """A detour of 6 cm (turning to and fro, edging) led into nothing: undoing it would only swap
+    sides where the robot stands (in the clinic, three such undos of 5 cm each cost a repeat its time)."""
+    a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0, undo=True), BackoffSettings(distance=0.0))
+    now, pose, side, world = _detour_into_a_wedge(a, length=0.06)
+    for t in np.arange(now + 0.1, now + 20.0, 0.5):
+        assert a.step(0.0, -side * 0.5, seen_of(world, pose), pose, float(t)).phase == "detour"
+    assert a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 20.2).gave_up.startswith("blocked for 20 s")
+    assert a.tally.backoffs == 0
