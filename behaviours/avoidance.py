@@ -15,6 +15,8 @@ child wrote (``child_command``: ``/robot/command`` unless remapped) against the 
   itself;
 - no direction will do: backing away ``backoff`` metres along the way the robot came
   (:mod:`maps.avoidance.backoff`), then judging again from there;
+- with ``undo``, a detour held until its ``timeout`` is driven back along its own way, once, and
+  the other side tried for ``wait`` seconds more (a detour into a gap too narrow to pass);
 - FAILURE, with the reason as the node's message ("blocked for 20 s by an obstacle 0.40 m
   ahead"), after ``timeout`` seconds held, or a detour of ``max_detour`` metres that did not get
   past, so that the mission's recovery (a search pattern, a new goal) takes over.
@@ -99,8 +101,8 @@ class AvoidObstacles(BearingsDecorator):
     PASS_TURNS = InputPort("pass_turns", bool, False, literal_only=True,
                            doc="a wish to turn on the spot passes in every phase (a child turning by a measured angle)")
     UNDO = InputPort("undo", bool, False, literal_only=True,
-                     doc="held on a detour with no direction: back along the detour's own way (however 'backoff' "
-                         "is set), then try the other side")
+                     doc="a detour held with no direction until 'timeout': back along its own way (however "
+                         "'backoff' is set), once, then try the other side for a 'wait' before giving up")
     GOING_ROUND = InputPort("going_round", bool, True, literal_only=True,
                             doc="give up a detour that has turned 180 deg (it goes round what the child heads for); "
                                 "false for a child whose own path turns (a search pattern)")

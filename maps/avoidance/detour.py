@@ -122,7 +122,7 @@ class DetourSettings:
     max_length: float = 6.0  # m: a detour this long that has not got past gives up
     pass_turns: bool = False  # a wish to turn on the spot passes in every phase (nodes that turn by a measured angle)
     going_round: bool = True  # a detour turned by GOING_ROUND gives up (off for nodes whose own path turns)
-    undo: bool = False  # held on a detour with no direction: back along the detour's own way, then the other side
+    undo: bool = False  # a detour held to its timeout: back along its own way, then the other side (module doc)
 
 
 @dataclass(frozen=True, slots=True)
@@ -402,7 +402,7 @@ class Avoidance:
             return None
         self.trail = trail
         episode.backing, episode.backed, episode.last, episode.back_limit = target, 0.0, pose, distance
-        if undo:  # the undo is a hold of its own: the one that timed out led into the wedge
+        if undo:  # the drive back has the hold's whole timeout; after it, only a wait (_back)
             episode.undoing, episode.undone, episode.held_since = True, True, now
         episode.backoffs += 1
         self._backed_from = _HoldEnded(episode.origin, now, pose, episode.backoffs)
