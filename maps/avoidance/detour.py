@@ -348,8 +348,8 @@ class Avoidance:
                 if held >= self.settings.wait else None
             if backing is not None:
                 return backing
-            if now - episode.held_since >= self.settings.timeout:
-                return self._give_up(self._blocked_reason(now - episode.held_since, v, w, around.points, choice), now)
+            if held >= self.settings.timeout:
+                return self._give_up(self._blocked_reason(held, v, w, around.points, choice), now)
         episode.side = episode.side or choice.side
         return Decision(*command, "detour", choice)
 
