@@ -23,9 +23,9 @@ AVOID = AvoidSettings(disc(0.26))
 CORNER = np.array([[0.35 * math.cos(a), 0.35 * math.sin(a)] for a in np.radians(np.arange(-90.0, 91.0, 10.0))])
 
 
-def seen(pose: Pose2D) -> np.ndarray:
-    """The corner's points in the base frame of ``pose``."""
-    return np.asarray(parent_to_frame(pose, CORNER))
+def seen(pose: Pose2D, world: np.ndarray = CORNER) -> np.ndarray:
+    """The ``world``'s points (odometry; the corner by default) in the base frame of ``pose``."""
+    return np.asarray(parent_to_frame(pose, world))
 
 
 def drive_in(a: Avoidance, start: float = -1.0) -> float:
@@ -196,21 +196,28 @@ def _detour_into_a_wedge(a: Avoidance, length: float = 0.4) -> tuple[float, Pose
     in (someone stepping up beside the person); returns the time, the pose, the side and the world points."""
     t = drive_in(a)
     here = Pose2D()
-    assert a.step(0.3, 0.0, seen_of(PERSON_AHEAD, here), here, t).phase == "waiting"
-    start = a.step(0.3, 0.0, seen_of(PERSON_AHEAD, here), here, t + 2.0)
+    assert a.step(0.3, 0.0, seen(here, PERSON_AHEAD), here, t).phase == "waiting"
+    start = a.step(0.3, 0.0, seen(here, PERSON_AHEAD), here, t + 2.0)
     assert start.phase == "detour" and start.choice is not None and start.choice.direction is not None
     side, psi = start.choice.side, start.choice.direction.angle
     now, pose = t + 2.0, here
     for s in np.arange(0.02, length + 0.01, 0.02):  # the robot drives the chosen direction, the node wishing back
         now += 0.1
         pose = Pose2D(float(s * math.cos(psi)), float(s * math.sin(psi)), psi)
-        assert a.step(0.0, -side * 0.5, seen_of(PERSON_AHEAD, pose), pose, now).phase == "detour"
+        assert a.step(0.0, -side * 0.5, seen(pose, PERSON_AHEAD), pose, now).phase == "detour"
     world = np.vstack((PERSON_AHEAD, _wedge(np.array([pose.x, pose.y]))))
     return now, pose, side, world
 
 
-def seen_of(world: np.ndarray, pose: Pose2D) -> np.ndarray:
-    return np.asarray(parent_to_frame(pose, world))
+def _back_to_the_start(a: Avoidance, now: float, pose: Pose2D, side: int, world: np.ndarray) -> tuple[float, Pose2D]:
+    """The robot backs along the detour to where it began while the avoidance backs it (odometry
+    fed by hand, 5 % of the way a tick); returns the time and the pose there."""
+    for f in np.arange(0.95, 0.0, -0.05):
+        now += 0.2
+        pose = Pose2D(pose.x * f / (f + 0.05), pose.y * f / (f + 0.05), pose.theta)
+        if a.step(0.0, -side * 0.5, seen(pose, world), pose, now).phase != "backoff":
+            break
+    return now, Pose2D(0.0, 0.0, pose.theta)
 
 
 def test_a_detour_wedged_on_its_way_round_is_undone_and_the_other_side_taken():
@@ -222,24 +229,17 @@ def test_a_detour_wedged_on_its_way_round_is_undone_and_the_other_side_taken():
     opens by itself (in the lab's seed 7 undoing after the 2 s wait lost a repeat that waiting got home)."""
     a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0, undo=True), BackoffSettings(distance=0.0))
     now, pose, side, world = _detour_into_a_wedge(a)
-    held = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 0.1)
+    held = a.step(0.0, -side * 0.5, seen(pose, world), pose, now + 0.1)
     assert (held.phase, held.v, held.w) == ("detour", 0.0, 0.0) and held.choice is not None
     assert held.choice.direction is None  # nothing within 90 deg of the route
     for t in np.arange(now + 0.5, now + 20.0, 0.5):  # held: a person beside it may yet walk on
-        d = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, float(t))
+        d = a.step(0.0, -side * 0.5, seen(pose, world), pose, float(t))
         assert (d.phase, d.v, d.w) == ("detour", 0.0, 0.0)
-    back = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 20.2)  # held for the timeout: undone
+    back = a.step(0.0, -side * 0.5, seen(pose, world), pose, now + 20.2)  # held for the timeout: undone
     assert back.phase == "backoff" and back.v < 0.0 and not back.gave_up
     assert back.event == "no way round: backing away 0.40 m the way it came"
-    now += 20.2
-    for f in np.arange(0.95, 0.0, -0.05):  # back along the detour to where it began
-        now += 0.2
-        pose = Pose2D(pose.x * f / (f + 0.05), pose.y * f / (f + 0.05), pose.theta)
-        step = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now)
-        if step.phase != "backoff":
-            break
-    pose = Pose2D(0.0, 0.0, pose.theta)
-    after = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 0.2)
+    now, pose = _back_to_the_start(a, now + 20.2, pose, side, world)
+    after = a.step(0.0, -side * 0.5, seen(pose, world), pose, now + 0.2)
     assert a.tally.backoffs == 1 and a.tally.backoff_length == pytest.approx(0.4, abs=0.03)
     assert after.phase == "detour" and after.choice is not None and after.choice.direction is not None
     assert after.choice.side == -side  # the other side of the person
@@ -249,9 +249,9 @@ def test_without_undo_the_wedged_detour_stays_held_with_back_offs_off_and_gives_
     a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0), BackoffSettings(distance=0.0))
     now, pose, side, world = _detour_into_a_wedge(a)
     for t in np.arange(now + 0.1, now + 20.0, 0.5):
-        d = a.step(0.0, -side * 0.5, seen_of(world, pose), pose, float(t))
+        d = a.step(0.0, -side * 0.5, seen(pose, world), pose, float(t))
         assert (d.phase, d.v, d.w) == ("detour", 0.0, 0.0)
-    assert a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 20.2).gave_up.startswith("blocked for 20 s")
+    assert a.step(0.0, -side * 0.5, seen(pose, world), pose, now + 20.2).gave_up.startswith("blocked for 20 s")
     assert a.tally.backoffs == 0
 
 
@@ -261,19 +261,14 @@ def test_an_undone_detour_held_on_the_other_side_too_gives_up_after_the_wait():
     a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0, undo=True), BackoffSettings(distance=0.0))
     now, pose, side, world = _detour_into_a_wedge(a)
     for t in np.arange(now + 0.1, now + 20.0, 0.5):  # held from now + 0.1
-        a.step(0.0, -side * 0.5, seen_of(world, pose), pose, float(t))
+        a.step(0.0, -side * 0.5, seen(pose, world), pose, float(t))
     now += 20.2
-    assert a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now).phase == "backoff"
-    for f in np.arange(0.95, 0.0, -0.05):
-        now += 0.2
-        pose = Pose2D(pose.x * f / (f + 0.05), pose.y * f / (f + 0.05), pose.theta)
-        if a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now).phase != "backoff":
-            break
-    pose = Pose2D(0.0, 0.0, pose.theta)
+    assert a.step(0.0, -side * 0.5, seen(pose, world), pose, now).phase == "backoff"
+    now, pose = _back_to_the_start(a, now, pose, side, world)
     boxed = np.vstack((world, _wedge(np.zeros(2)), _wedge(np.zeros(2)) * [1.0, -1.0]))  # nothing free here now
-    held = a.step(0.0, -side * 0.5, seen_of(boxed, pose), pose, now + 0.2)
+    held = a.step(0.0, -side * 0.5, seen(pose, boxed), pose, now + 0.2)
     assert (held.phase, held.v, held.w, held.gave_up) == ("detour", 0.0, 0.0, "")
-    d = a.step(0.0, -side * 0.5, seen_of(boxed, pose), pose, now + 2.2)
+    d = a.step(0.0, -side * 0.5, seen(pose, boxed), pose, now + 2.2)
     assert d.gave_up.startswith("blocked for 20 s") and a.tally.give_ups == 1
 
 
@@ -283,6 +278,6 @@ def test_a_detour_that_hardly_moved_is_not_undone_it_gives_up_as_before():
     a = Avoidance(AVOID, DetourSettings(wait=2.0, timeout=20.0, undo=True), BackoffSettings(distance=0.0))
     now, pose, side, world = _detour_into_a_wedge(a, length=0.06)
     for t in np.arange(now + 0.1, now + 20.0, 0.5):
-        assert a.step(0.0, -side * 0.5, seen_of(world, pose), pose, float(t)).phase == "detour"
-    assert a.step(0.0, -side * 0.5, seen_of(world, pose), pose, now + 20.2).gave_up.startswith("blocked for 20 s")
+        assert a.step(0.0, -side * 0.5, seen(pose, world), pose, float(t)).phase == "detour"
+    assert a.step(0.0, -side * 0.5, seen(pose, world), pose, now + 20.2).gave_up.startswith("blocked for 20 s")
     assert a.tally.backoffs == 0
