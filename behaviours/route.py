@@ -48,7 +48,7 @@ How the paper is read here (where it is vague):
   (nothing left to wait for: the recovery may skip past it), and lost is lost as before. Stopping
   the lost timer for the whole of a hold was tried and dropped: in the lab with 3 people standing
   on the route the robot then stood 20 s (``timeout``) behind someone again and again (95 s in
-  one repeat) and got home no more often (docs/obstacles.md).
+  one repeat) and got home no more often (docs/obstacles-measured.md).
 - **Odometry while lost (a departure, off by default).** With ``odometry_reach`` > 0 and a map
   taught with odometry, lost after a switch, the robot drives on by the taught odometry through the
   next viewframes' places (:mod:`behaviours.route_anchor` ties the two odometry frames at each

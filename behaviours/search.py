@@ -11,7 +11,7 @@ about the time its eights take even where people stand on them. Until stop 42 th
 driven open loop, as a fixed speed and turn rate, and every detour of the avoidance round a
 person moved the rest of it: in the office with 3 more people on the route, one search's eights
 walked the robot 1.5 m through a door into the meeting room, where nothing of the route was in
-view (docs/obstacles.md). Every new
+view (docs/obstacles-measured.md). Every new
 observation is matched against the target viewframe and the next ones along the route
 (``window``), then the ones before it (``behind``): the first with enough matches (the same rule
 as ``FollowRoute``'s) and a valid Z-infinity rotation becomes the target, and the node succeeds so
@@ -26,7 +26,7 @@ With ``behind``, viewframes already passed count too (a departure: the paper sea
 robot that lost the trail getting round people has often been pushed back or aside, nearer the
 viewframes it passed than the one it lost; following again from one of them costs a few metres,
 while an eight that does not find the lost one fails the mission. ``behind`` is 0 (off) in the
-shipped ``follow_route``: in the clinic with 3 people on the route (docs/obstacles.md) it got no
+shipped ``follow_route``: in the clinic with 3 people on the route (docs/obstacles-measured.md) it got no
 more repeats home (0 of 3 against 1 of 3), the robot re-following passed viewframes into a room.
 """
 

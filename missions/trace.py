@@ -7,7 +7,7 @@ the command sent to the base, the collision monitor's state, the phase of every 
 the simulator also the robot's true pose and the two nearest people within 2 m (the evaluation's
 view: no behaviour reads them), and a line of its own whenever the robot comes nearer to anything
 than it has so far, once that is under :data:`NEAR_M` (a contact in the making). This is how the
-traces in docs/obstacles.md were taken: a stand-off, a detour round the wrong side, a lost trail
+traces in docs/obstacles-measured.md were taken: a stand-off, a detour round the wrong side, a lost trail
 read off a few hundred lines.
 """
 

@@ -16,7 +16,7 @@ even odds:
   each side (cut where a wall, box or pillar comes nearer than the person's radius), at a speed
   in :data:`SPEEDS`, resting at each end up to ``--option rest=S`` seconds (:data:`WAIT_S`, 2 s, by
   default: people who pace a corridor with hardly a rest are a wall the robot must time its way
-  through, and a longer rest changes only how long each person rests: docs/obstacles.md, stop 43).
+  through, and a longer rest changes only how long each person rests: docs/obstacles-measured.md, stop 43).
   A crossing goes a body's width to each side of the way; a person who finds no place so (a route
   along a corridor 1.5 m wide, 0.5 m on each side of its middle: before, such a route got nobody
   at all) may cross shorter, half a body's width to each side, when, paused at either end, they
