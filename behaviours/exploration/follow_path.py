@@ -83,7 +83,7 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.exploration.ports import CLEARANCE, GOAL, MAP, POSE, ROBOT_RADIUS, disc_radius
+from behaviours.exploration.ports import CLEARANCE, GOAL, MAP, MARGIN, PENALTY, POSE, ROBOT_RADIUS, disc_radius
 from behaviours.footprint import FOOTPRINT
 from behaviours.keys import RANGES_KEY
 from behaviours.motion import ANGULAR_DECEL, COMMAND, LINEAR_DECEL, STALLED, ramp
@@ -148,10 +148,6 @@ class FollowPath(BearingsBehaviour):
                               literal_only=True, doc="turn on the spot when the carrot is this far off the heading")
     CHECK_DISTANCE = InputPort("check_distance", float, 0.8, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
                                doc="how much of the path ahead must stay clear")
-    MARGIN = InputPort("margin", float, 0.3, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
-                       doc="re-planned paths: steps with less clearance than robot_radius + margin cost more")
-    PENALTY = InputPort("penalty", float, 3.0, minimum=0.0, maximum=100.0, literal_only=True,
-                        doc="...up to (1 + penalty) times their length")
     BACKOFF = InputPort("backoff", float, 1.0, unit="s", minimum=0.0, maximum=10.0, literal_only=True,
                         doc="after a stall, back away this long")
     MAX_STALLS = InputPort("max_stalls", int, 3, minimum=1, maximum=100, literal_only=True,
@@ -251,7 +247,7 @@ class FollowPath(BearingsBehaviour):
             self.replans += 1
             planned = disc_radius(self) + self.get_input(CLEARANCE)
             travel = travel_cost(m, (pose.x, pose.y), planned,
-                                 margin=self.get_input(self.MARGIN), penalty=self.get_input(self.PENALTY))
+                                 margin=self.get_input(MARGIN), penalty=self.get_input(PENALTY))
             path = travel.path_to(goal.target)
             if len(path) and not len(self._blocking(m, path)):
                 self.path, self.index, self.waiting_since = path, 0, None

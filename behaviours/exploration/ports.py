@@ -20,6 +20,10 @@ ROBOT_RADIUS = InputPort("robot_radius", float, 0.0, unit="m", minimum=0.0, maxi
 CLEARANCE = InputPort("clearance", float, 0.05, unit="m", minimum=0.0, maximum=1.0, literal_only=True,
                       doc="room kept between the disc and obstacle cells beyond robot_radius (localisation "
                           "error): paths are planned with it, and FollowPath stops the robot short of it")
+MARGIN = InputPort("margin", float, 0.3, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
+                   doc="paths with less clearance than robot_radius + clearance + margin cost more")
+PENALTY = InputPort("penalty", float, 3.0, minimum=0.0, maximum=100.0, literal_only=True,
+                    doc="...up to (1 + penalty) times their length")
 MAP = InputPort("map", ExplorationMap, Ref("/map/exploration"), doc="the exploration map")
 GOAL = InputPort("goal", Goal, Ref("/map/exploration_goal"), doc="the exploration goal (None: none)")
 POSE = InputPort("odometry", Pose2D, Ref("/robot/odometry"),

@@ -18,7 +18,7 @@ import numpy as np
 from py_trees.common import Status
 
 from behaviours.base import BearingsBehaviour
-from behaviours.exploration.ports import CLEARANCE, MAP, POSE, ROBOT_RADIUS, disc_radius
+from behaviours.exploration.ports import CLEARANCE, MAP, MARGIN, PENALTY, POSE, ROBOT_RADIUS, disc_radius
 from behaviours.footprint import FOOTPRINT
 from behaviours.ports import InputPort, OutputPort
 from behaviours.registry import register
@@ -82,10 +82,6 @@ class SelectGoalPoint(BearingsBehaviour):
                     doc="weight of the travel cost in eq. 1")
     K = InputPort("k", float, 1.0, unit="m", minimum=0.0, maximum=100.0, literal_only=True,
                   doc="a point must lie this far beyond the border to attract")
-    MARGIN = InputPort("margin", float, 0.3, unit="m", minimum=0.0, maximum=5.0, literal_only=True,
-                       doc="paths with less clearance than robot_radius + clearance + margin cost more")
-    PENALTY = InputPort("penalty", float, 3.0, minimum=0.0, maximum=100.0, literal_only=True,
-                        doc="...up to (1 + penalty) times their length")
     PATIENCE = InputPort("patience", int, 2, minimum=1, maximum=100, literal_only=True,
                          doc="selections in a row without a reachable border before done")
     MIN_FRONTIER = InputPort("min_frontier", float, 0.3, unit="m", minimum=0.0, maximum=10.0, literal_only=True,
@@ -122,7 +118,7 @@ class SelectGoalPoint(BearingsBehaviour):
             eta=self.get_input(self.ETA), k=self.get_input(self.K),
             robot_radius=self.get_input(ROBOT_RADIUS) + self.get_input(CLEARANCE),
             min_frontier=self.get_input(self.MIN_FRONTIER),
-            margin=self.get_input(self.MARGIN), penalty=self.get_input(self.PENALTY),
+            margin=self.get_input(MARGIN), penalty=self.get_input(PENALTY),
             patience=self.get_input(self.PATIENCE), hysteresis=self.get_input(self.HYSTERESIS),
             closest_frontier=strategy == "closest_frontier",
             nearby=self.get_input(self.NEARBY) if strategy == "nearby_attraction" else math.inf,

@@ -8,7 +8,7 @@ shortened (SIPs every 20 ms, a 0.2 s SIP timeout...) so the fault tests take fra
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from typing import Any
+from typing import Any, TypeVar
 
 import pytest
 
@@ -16,6 +16,8 @@ from drivers.pioneer import PioneerBase, open_base
 from drivers.ptu_d46 import PtuD46, open_ptu
 from tests.drivers.arcos_emulator import ArcosEmulator
 from tests.drivers.ptu_emulator import PtuEmulator
+
+E = TypeVar("E", ArcosEmulator, PtuEmulator)
 
 FAST_EMULATOR = {"sip_period": 0.02}
 FAST_BASE = {"sip_timeout": 0.2, "resend_period": 0.05, "reply_timeout": 0.1, "connect_timeout": 2.0,
@@ -26,26 +28,22 @@ FAST_PTU = {"reply_timeout": 0.2, "poll_period": 0.03, "init_settle": 0.04}
 @pytest.fixture
 def arcos() -> Iterator[Callable[..., ArcosEmulator]]:
     """``arcos(**options)`` starts an ARCOS emulator (pty unless ``transport="tcp"``)."""
-    made: list[ArcosEmulator] = []
-
-    def make(**options: Any) -> ArcosEmulator:
-        emulator = ArcosEmulator(**{**FAST_EMULATOR, **options}).start()
-        made.append(emulator)
-        return emulator
-
-    yield make
-    for emulator in made:
-        emulator.close()
-    for emulator in made:
-        assert emulator.crashed is None, f"the ARCOS emulator crashed: {emulator.crashed!r}"
+    yield from _started("ARCOS", lambda **options: ArcosEmulator(**{**FAST_EMULATOR, **options}).start())
 
 
 @pytest.fixture
 def ptu_emulator() -> Iterator[Callable[..., PtuEmulator]]:
-    made: list[PtuEmulator] = []
+    """``ptu_emulator(**options)`` starts a PTU-D46 emulator."""
+    yield from _started("PTU", lambda **options: PtuEmulator(**options).start())
 
-    def make(**options: Any) -> PtuEmulator:
-        emulator = PtuEmulator(**options).start()
+
+def _started(name: str, start: Callable[..., E]) -> Iterator[Callable[..., E]]:
+    """A fixture's factory that remembers what ``start`` made; at teardown each is closed, then a
+    crash inside any of them fails the test."""
+    made: list[E] = []
+
+    def make(**options: Any) -> E:
+        emulator = start(**options)
         made.append(emulator)
         return emulator
 
@@ -53,7 +51,7 @@ def ptu_emulator() -> Iterator[Callable[..., PtuEmulator]]:
     for emulator in made:
         emulator.close()
     for emulator in made:
-        assert emulator.crashed is None, f"the PTU emulator crashed: {emulator.crashed!r}"
+        assert emulator.crashed is None, f"the {name} emulator crashed: {emulator.crashed!r}"
 
 
 @pytest.fixture
