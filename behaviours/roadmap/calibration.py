@@ -35,7 +35,7 @@ from behaviours.registry import register
 from behaviours.roadmap.routine import ROUTINE_PORTS, Failed, RoutineBehaviour, Step
 from behaviours.roadmap.vision import compare, describe
 from behaviours.telemetry import Figure
-from perception.geometry import Pose2D
+from perception.geometry import Pose2D, wrap_angle
 
 MAX_ERROR = 0.1  # a scale further than 10 % from 1 is not odometry miscounting: refuse it
 ATTEMPTS = 4  # headings 90 degrees apart to try when the images do not match
@@ -45,8 +45,12 @@ ATTEMPTS = 4  # headings 90 degrees apart to try when the images do not match
 class CalibrateTurns(RoutineBehaviour):
     """Turn a full circle on the spot and compare the images before and after: the odometry's turn scale.
 
-    Writes ``true turn / counted turn`` to ``turn_scale`` (read by ``CorrectOdometry``). FAILURE when
-    the two images do not match or the scale is implausible (more than 10 % from 1).
+    Writes ``true turn / counted turn`` to ``turn_scale`` (read by ``CorrectOdometry``). Where the
+    two images do not match (a bare wall), it faces another way, a quarter turn on, and tries again,
+    up to four headings; matched on another, it turns back to the heading it started at (by the scale
+    just measured), so that what follows (the room estimation's dodecagon, laid out to the robot's
+    left) starts where the robot was put down. FAILURE when no heading matches or the scale is
+    implausible (more than 10 % from 1).
     """
 
     TURN_SCALE = OutputPort("turn_scale", float, "/robot/turn_scale", doc="true turn / turn counted by the odometry")
@@ -69,7 +73,11 @@ class CalibrateTurns(RoutineBehaviour):
             inliers = max(inliers, found.inliers)
             if found.matched():
                 # planar.theta: the turn from the image after to the one before, i.e. minus what odometry missed
-                yield from self._write(1.0 - found.planar.theta / (2.0 * math.pi))
+                scale = 1.0 - found.planar.theta / (2.0 * math.pi)
+                yield from self._write(scale)
+                if attempt:  # back to the heading it started at: what follows is laid out from there
+                    counted = attempt * (math.pi / 2.0 + 2.0 * math.pi) + 2.0 * math.pi  # the odometry's turns
+                    yield from self.rotate(-wrap_angle(scale * counted) / scale, "facing the start heading again")
                 return
         raise Failed(f"the images before and after a full turn never matched ({inliers} inliers at best)")
 

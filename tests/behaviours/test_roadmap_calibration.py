@@ -70,3 +70,27 @@ def test_an_unset_or_zero_turn_scale_counts_as_one():
     harness.write("/robot/odometry", Pose2D(0.0, 0.0, 0.3, 0.1))
     harness.tick()
     assert harness.read("/robot/calibrated_odometry").theta == pytest.approx(0.3)
+
+
+@pytest.mark.parametrize("gain", [1.0, 1.02])
+def test_matched_on_another_heading_it_faces_the_start_heading_again(monkeypatch, gain):
+    """The first full turn faces a bare wall; the second, a quarter turn on, matches. The robot then
+    turns back to the heading it started at (to within a degree, true heading): what follows (the room
+    estimation's dodecagon) is laid out from where the robot was put down. In the clinic's hallway
+    the dodecagon was driven a quarter turn off and into a wall: the eval had checked its room at the
+    start heading."""
+    real, calls = calibration.compare, []
+
+    def first_unmatched(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 1:
+            return Comparison(0, PlanarResult(0.0, np.zeros(2), np.zeros(0, bool), PlanarStatus.NO_CONSENSUS))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(calibration, "compare", first_unmatched)
+    world = FakeWorld(start=Pose2D(4.0, 3.0, 0.2), turn_gain=gain)
+    harness = BehaviourHarness(CalibrateTurns(), blackboard=world.blackboard())
+    assert harness.tick_until(between=world.step, max_ticks=5000) == Status.SUCCESS
+    assert len(calls) == 2 and harness.read("/robot/turn_scale") == pytest.approx(gain, abs=0.002)
+    turned = math.remainder(world.true_pose().theta - 0.2, 2 * math.pi)
+    assert math.degrees(turned) == pytest.approx(0.0, abs=1.0)  # 360 + 90 + 360 (x gain), then back
