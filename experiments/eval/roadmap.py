@@ -29,7 +29,9 @@ Episodes (all through the sweep runner, in the results folder), per seed:
 Figures (simulator ground truth, evaluation only):
 
 - where the targets came from, ``targets.source`` (``"named poses"`` or ``"placed"``), and where
-  they are, ``targets.poses`` (per seed, ``[x m, y m, theta deg]`` in the world frame);
+  they are, ``targets.poses`` (per seed, ``[x m, y m, theta deg]`` in the world frame); those a wall
+  hides from where the learning starts, ``targets.out_of_sight`` (per seed: the method learns the
+  room it starts in, :func:`~experiments.eval.roadmap_world.out_of_sight`);
 - per target found: its estimated pose (the report's ``roadmap.targets``, reference frame) against
   its true pose expressed in the TRUE reference frame, the robot's true pose at the report's
   ``roadmap.room.reference_stamp`` (:class:`~experiments.eval.trajectory.TrueTrajectory`: exact,
@@ -72,6 +74,7 @@ from experiments.eval import people as crowd
 from experiments.eval.figures import cell, interval_cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.roadmap_world import (
     learn_start,
+    out_of_sight,
     place_targets,
     pose_error,
     random_starts,
@@ -449,7 +452,9 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     targets = {seed: seed_targets(world, loaded, settings, seed, folder, grid) for seed in options.seeds}
     truth = {seed: t.poses for seed, t in targets.items()}
     navigate_in, people = navigation_worlds(loaded, settings, targets, folder, grid)
-    episodes, rows = _learn_phase(options, targets, settings, folder, resume, _moved_start(loaded, grid))
+    moved = _moved_start(loaded, grid)
+    hidden = {seed: out_of_sight(loaded, moved or loaded.start, t.poses) for seed, t in targets.items()}
+    episodes, rows = _learn_phase(options, targets, settings, folder, resume, moved)
     learns, plans = [], []
     for seed, episode in sorted(episodes.items()):
         figures = learn_figures(seed, read_report(folder, episode.id), rows.get(episode.id), truth[seed])
@@ -465,6 +470,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     gotos = [goto_figures(p, read_report(folder, p.episode.id), rows.get(p.episode.id), truth[p.episode.seed][p.goal])
              for p in plans]
     out = summarise(loaded.name, settings, learns, gotos, truth)
+    out["targets.out_of_sight"] = {str(seed): list(names) for seed, names in hidden.items()}
     return {**out, **settings.people.figures(people)}
 
 
@@ -502,6 +508,9 @@ def format_table(figures: Mapping[str, Any]) -> str:
         lines += [f"seed {seed} placed targets: " + ", ".join(f"{n} ({x:g}, {y:g}, {deg:g} deg)"
                                                                for n, (x, y, deg) in by_name.items())
                   for seed, by_name in f["targets.poses"].items()]
+    lines += [f"seed {seed}: {', '.join(names)} out of sight of where the learning starts, behind a wall: the "
+              "roadmap learns the targets of the room it starts in (give --option targets=... in that room)"
+              for seed, names in f.get("targets.out_of_sight", {}).items() if names]
     lines += crowd.table_line(f)
     lines += [f"seed {x['seed']} {x['episode']}: {x['status']}: {x['reason']}" for x in f["failures"]]
     return "\n".join(lines)

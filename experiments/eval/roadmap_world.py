@@ -75,6 +75,8 @@ TARGET_DRAWS = 10_000  # draws for a placed target at TARGET_CLEARANCE before ST
 TARGET_CANDIDATES = 3  # positions drawn per placed target; the one with the best view is kept
 PREFERRED_CENTRE = (2.0, 4.0)  # m: a placed target's optical axis preferably meets its surface this far away
 DODECAGON_MARGIN = 0.35  # m spare round the dodecagon at a moved start: the monitor's slow-down margin
+SIGHT_HEIGHT = 2.0  # m: a line of sight this high passes over desks, cabinets and people; walls and pillars stop it
+SIGHT_SPREAD = 0.3  # m: ... drawn to the target and this far to each side of it: a pillar does not hide all three
 LEARN_HEADINGS = 12  # headings tried at each place for a learning start (every 30 deg)
 
 T = TypeVar("T")
@@ -365,6 +367,24 @@ def learn_start(world: World, grid: FloorGrid, side: float = RoomEstimationDodec
                 return Pose2D(x, y, theta)
     raise ValueError(f"world {world.name!r} has no reachable place where the room estimation's dodecagon (side "
                      f"{side:g} m) fits: a free disc {2.0 * need:.2f} m across")
+
+
+def out_of_sight(world: World, start: Pose2D, targets: Mapping[str, Pose2D]) -> tuple[str, ...]:
+    """The targets a wall hides from where the learning starts: the lines of sight at
+    :data:`SIGHT_HEIGHT` to the target and :data:`SIGHT_SPREAD` to each side of it all meet a wall or
+    a pillar (the scene's own occlusion test). The roadmap learns the targets of the room it starts
+    in (the paper's method); one in another room is not found, and the evaluation says so."""
+    scene = Scene(world)
+    eye = np.array([start.x, start.y, SIGHT_HEIGHT])
+    hidden = []
+    for name, pose in targets.items():
+        away = np.array([pose.x - start.x, pose.y - start.y])
+        across = np.array([-away[1], away[0]]) / max(float(np.hypot(*away)), 1e-9)
+        ends = [[pose.x + k * SIGHT_SPREAD * across[0], pose.y + k * SIGHT_SPREAD * across[1], SIGHT_HEIGHT]
+                for k in (-1.0, 0.0, 1.0)]
+        if scene.occluded(eye, np.array(ends)).all():
+            hidden.append(name)
+    return tuple(sorted(hidden))
 
 
 def has_room(grid: FloorGrid, clearance: float) -> bool:

@@ -321,6 +321,9 @@ def test_the_summary_from_hand_made_runs():
     empty = summarise("w", settings, learns[1:], [])
     assert empty["goto.reached_rate"] is None and empty["goto.error_worst_m"] is None
     assert "goto reached 0 of 0 run" in format_table(empty) and "rate -, -)" in format_table(empty)
+    hidden = format_table({**figures, "targets.out_of_sight": {"0": ["b"], "1": []}})
+    assert "seed 0: b out of sight of where the learning starts, behind a wall" in hidden
+    assert not any(line.startswith("seed 1: ") for line in hidden.splitlines())  # every target in sight: nothing
 
 
 def test_targets_and_options_are_checked_against_the_world(world_file):

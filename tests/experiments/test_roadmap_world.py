@@ -9,7 +9,8 @@ import yaml
 
 from drivers.sim.scene import Scene
 from drivers.sim.world import load_world
-from experiments.eval.roadmap_world import learn_start, reachable_grid
+from experiments.eval.roadmap_world import learn_start, out_of_sight, reachable_grid
+from perception.geometry import Pose2D
 
 CIRCLE = 0.25 / (2.0 * math.sin(math.pi / 12))  # 0.4830 m: the corners' circle of a 0.25 m side
 # A 1.4 m hallway (y 0-1.4) from x = 0 to 6, opening at its east end into a 4 x 4 m room (x 6-10).
@@ -48,3 +49,29 @@ def test_a_world_with_no_room_anywhere_says_so(tmp_path):
     world = world_file(tmp_path, narrow)
     with pytest.raises(ValueError, match="no reachable place where the room estimation's dodecagon"):
         learn_start(world, reachable_grid(world))
+
+
+# Two rooms, 4 x 4 m each, side by side: the wall between them at x = 4 has a door at y 2.8-4.
+# A pillar (0.1 m) in the west room on the line from the start to one target, a cabinet (1.9 m)
+# lower than the line of sight (2 m) in front of another.
+TWO_ROOMS = {
+    "name": "two_rooms", "start": {"x": 0.8, "y": 2.0, "theta_deg": 0},
+    "walls": [{"points": [[0, 0], [8, 0], [8, 4], [0, 4]], "closed": True, "height": 2.4},
+              {"points": [[4, 0], [4, 2.8]], "height": 2.4}],
+    "pillars": [{"center": [2.0, 2.0], "radius": 0.1, "height": 2.4}],
+    "boxes": [{"center": [2.0, 3.2], "size": [0.6, 0.4], "height": 1.9}],
+}
+
+
+def test_targets_behind_a_wall_are_out_of_sight_of_the_learning_start(tmp_path):
+    """Worked by hand from the start (0.8, 2.0): to (6, 1) the line crosses x = 4 at y = 1.38, and
+    the lines to 0.3 m each side of it at 1.2-1.6, all below the door (2.8): hidden. To (6, 3.4) the
+    middle line crosses at 2.86, through the door: in sight. The pillar hides the line to (3.2, 2.0)
+    but not those 0.3 m to each side (0.15 m from its centre at x = 2); the cabinet is below the line.
+    From (6, 1) in the east room the lines to the pillar's target cross x = 4 at 1.50-1.95, those to
+    the cabinet's at 2.13-2.48: both hidden."""
+    world = world_file(tmp_path, TWO_ROOMS)
+    targets = {"next_room": Pose2D(6.0, 1.0, 0.0), "through_door": Pose2D(6.0, 3.4, 0.0),
+               "behind_pillar": Pose2D(3.2, 2.0, 0.0), "behind_cabinet": Pose2D(2.0, 3.6, 0.0)}
+    assert out_of_sight(world, world.start, targets) == ("next_room",)
+    assert out_of_sight(world, Pose2D(6.0, 1.0, 0.0), targets) == ("behind_cabinet", "behind_pillar")
