@@ -12,6 +12,13 @@ Choices where the paper is vague:
   between it and the real point. A goal farther than ``SNAP`` (0.6 m) from standable floor has no
   path (the routine fails with the reason); the start has no such limit (the robot stands on
   free floor, whatever the map says).
+- **A robot cut off from the goal in the map** (its nearest standable floor lies in another free
+  region than the goal's): planned from the nearest standable floor of the goal's region, driven
+  to straight. The robot got where it stands (homing to a target drives by the images, not on
+  the map), and the map's cut may be a person the stereo pairs saw who has moved on; the
+  collision monitor judges the straight drive. Without this, in `annex` a robot homed to a
+  target beyond a pacing person's mark failed every return and every one of the 40 search rounds
+  in 2 s ("start and goal lie in separate free regions").
 - The room's reference pose moves in the odometry frame when the robot homes to the reference
   image again (:func:`reanchored`): the map and its free grid stay as they are.
 """
@@ -39,13 +46,19 @@ PLAN_PORTS: tuple[Port, ...] = (PLAN_TIME_IN, PLAN_OUT)
 """The ports of a node that plans; a routine without them plans within ``PLAN_TIME`` and writes no plan."""
 
 
-def nearest_standable(free: FreeGrid, x: float, y: float, radius: float, snap: float = SNAP
-                      ) -> tuple[float, float] | None:
+def nearest_standable(free: FreeGrid, x: float, y: float, radius: float, snap: float = SNAP,
+                      region: int | None = None) -> tuple[float, float] | None:
     """(x, y) itself when the robot may stand there, else the nearest standable cell centre within
-    ``snap``; None when there is none."""
-    if free.can_stand(np.array([[x, y]]), radius)[0]:
-        return x, y
-    standable = free.standable(radius)
+    ``snap``; None when there is none. With ``region`` (a label of :meth:`FreeGrid.regions`), only
+    floor of that region will do."""
+    if region is None:
+        if free.can_stand(np.array([[x, y]]), radius)[0]:
+            return x, y
+        standable = free.standable(radius)
+    else:
+        if free.region_at(np.array([[x, y]]), radius)[0] == region:
+            return x, y
+        standable = free.regions(radius) == region
     if not standable.any():
         return None
     centres = free.centres()[standable]
@@ -73,6 +86,10 @@ def plan(host: RoutineBehaviour, room: RoomEstimate, goal: Pose2D) -> Step[PlanR
     if start is None or end is None:
         what = "robot" if start is None else "goal"
         raise Failed(f"no path: the {what} is more than {SNAP} m from floor where the robot may stand")
+    goal_region = int(room.free.region_at(np.array([end]), radius)[0])
+    if room.free.region_at(np.array([start]), radius)[0] != goal_region:  # the robot stands cut off from the goal
+        start = nearest_standable(room.free, here.x, here.y, radius, snap=math.inf, region=goal_region)
+        assert start is not None  # the goal's own cell is in its region
     limit = host.get_input(PLAN_TIME_IN) if PLAN_TIME_IN.name in host.inputs else PLAN_TIME
     result = plan_path(room.free, Pose2D(start[0], start[1], here.theta), Pose2D(end[0], end[1], goal.theta),
                        robot_radius=radius, time_limit=limit)

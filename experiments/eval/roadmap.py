@@ -3,25 +3,31 @@ from unknown start poses (docs/design.md's method 2, ``docs/roadmap.md``).
 
 Episodes (all through the sweep runner, in the results folder), per seed:
 
+0. **The learning's room**: the method learns the targets of the room it starts in and navigates
+   in it (docs/roadmap.md), so the targets and starts it is evaluated on are drawn there:
+   :func:`~experiments.eval.roadmap_world.learning_room`, the reachable floor in sight of where the
+   learning starts, cut at the doors (the whole floor of a one-room world such as the lab);
+   placed targets 0.45 m or more from its exits, never in a doorway.
 1. **Target images**: one front-camera image per target, made with ``bearings sim snapshot`` at the
    target poses (lighting of the seed) into ``seeds/<world>_s<seed>/targets/``. The targets are
-   either the world's **named poses** where the robot can stand and that it can reach from the
-   start (``--option targets=a,b,c`` chooses among them; at least 2), or ``t1``..``tN`` **placed**
-   in the free space (``--option targets=N``, 2 to 12; the default, 4 of them, when the world has
-   fewer than 2 usable named poses): drawn from the seed by
-   :func:`~experiments.eval.roadmap_world.place_targets` (reachable, 0.7 m clear when there is room,
-   else 0.45 m, 1.5 m apart, the front camera facing at least two surfaces 1-5 m away on every
-   ray across its view, preferring an axis 2-4 m long and the view with the most reachable floor
-   in it: one the search can find). Placed
+   either the world's **named poses** where the robot can stand (by default those in the
+   learning's room; ``--option targets=a,b,c`` chooses any the robot can reach from the start;
+   at least 2), or ``t1``..``tN`` **placed** in the learning's room (``--option targets=N``, 2 to
+   12; the default, 4 of them (fewer when the room has no space for 4 for every seed, down to 2), when the room
+   holds fewer than 2 usable named poses): drawn from
+   the seed by :func:`~experiments.eval.roadmap_world.place_targets` (reachable, 0.7 m clear when
+   there is room, else 0.45 m, 1.5 m apart, the front camera facing at least two surfaces 1-5 m
+   away on every ray across its view, preferring an axis 2-4 m long and the view with the most
+   reachable floor in it: one the search can find). Placed
    targets are added to a copy of the world file, ``seeds/<world>_s<seed>/<world>.yaml``, and that
    seed's snapshots, learn and goto episodes all run in the copy (self-contained, resumable).
 2. **Learn**: ``learn_targets`` from the world's start with that folder; it writes the roadmap to
    ``seeds/<world>_s<seed>/<world>.roadmap``. A start where the room estimation's dodecagon would
    touch a surface (a hallway) is moved to the nearest reachable pose where it fits
    (:func:`~experiments.eval.roadmap_world.learn_start`; the run's ``--start``).
-3. **Goto**: ``goto_target`` from ``--option starts=N`` random start poses (default 5;
-   :func:`~experiments.eval.roadmap_world.random_starts`: uniform in the world's bounds, at least
-   0.45 m clear of every surface, reachable, any heading, drawn from the seed alone), each to a goal
+3. **Goto**: ``goto_target`` from ``--option starts=N`` random start poses in the learning's room
+   (default 5; :func:`~experiments.eval.roadmap_world.random_starts`: uniform, at least 0.45 m
+   clear of every surface, any heading, drawn from the seed alone), each to a goal
    drawn (from the seed) among the targets the learning found, with the roadmap it wrote. They
    run when the learning left a roadmap file (a graph that is not connected included: its
    navigations are measured too), all seeds' together.
@@ -61,7 +67,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -74,6 +80,7 @@ from experiments.eval import people as crowd
 from experiments.eval.figures import cell, interval_cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.roadmap_world import (
     learn_start,
+    learning_room,
     out_of_sight,
     place_targets,
     pose_error,
@@ -95,8 +102,9 @@ DEFAULT_STARTS, MAX_STARTS = 5, 1000
 DESCRIPTION = "learn a roadmap from target images, navigate to them: target pose errors, graph, goto reached"
 OPTIONS = {
     "targets": "the named poses of the world to take target images at, a,b,c (at least 2), or a count N (2 to 12) "
-               "of targets placed in the free space from the seed (default: every named pose the robot can stand "
-               "at and reach from the start; 4 placed when fewer than 2)",
+               "of targets placed in the free space of the learning's room from the seed (default: every named pose "
+               "the robot can stand at in the room the learning starts in; 4 placed there, or as many as it "
+               "holds, when fewer than 2)",
     "starts": f"random start poses per seed to navigate from (default {DEFAULT_STARTS}; 0: learning only)",
     crowd.OPTION: crowd.HELP + " (the navigations': between the targets)",
     crowd.REST_OPTION: crowd.REST_HELP,
@@ -118,6 +126,7 @@ class Settings:
     starts: int
     source: str = NAMED
     people: crowd.Crowd = crowd.Crowd()  # people in the navigations' world
+    fewer: bool = field(default=False, compare=False)  # the default count of placed targets: fewer if a seed needs
 
 
 @dataclass(frozen=True)
@@ -163,22 +172,29 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     any episode runs."""
     loaded = load_world(world)
     grid = reachable_grid(loaded)
-    targets, source = choose_targets(extra.get("targets"), loaded, usable_poses(loaded, grid))
+    start = learn_start(loaded, grid)  # ValueError: no room for the dodecagon
+    room = learning_room(loaded, grid, start)
+    targets, source = choose_targets(extra.get("targets"), loaded, usable_poses(loaded, grid),
+                                     usable_poses(loaded, room))
     if source == PLACED:
-        place_targets(loaded, len(targets), 0, grid=grid)  # ValueError: no room for them
+        inner = learning_room(loaded, grid, start, inner=True)
+        targets = placeable(loaded, targets, inner, fewer=extra.get("targets") is None)
+    fewer = source == PLACED and extra.get("targets") is None
     starts = parse_starts(extra.get("starts"))
     if starts:
-        random_starts(loaded, 1, 0, grid=grid)  # ValueError: nowhere clear enough to start from
-    return Settings(targets, starts, source, crowd.Crowd.from_options(extra))
+        random_starts(loaded, 1, 0, grid=room)  # ValueError: nowhere clear enough to start from
+    return Settings(targets, starts, source, crowd.Crowd.from_options(extra), fewer=fewer)
 
 
-def choose_targets(text: str | None, world: World, usable: Mapping[str, Pose2D]) -> tuple[tuple[str, ...], str]:
+def choose_targets(text: str | None, world: World, usable: Mapping[str, Pose2D],
+                   in_room: Mapping[str, Pose2D]) -> tuple[tuple[str, ...], str]:
     """The target names and their source from the ``targets`` option: a count N (digits) places
-    ``t1``..``tN``; names are named poses; none: the usable named poses, or ``DEFAULT_PLACED``
-    placed targets when there are fewer than 2 of them."""
+    ``t1``..``tN``; names are named poses (``usable``: anywhere the robot can stand and reach);
+    none: the usable named poses in the room the learning starts in (``in_room``), or
+    ``DEFAULT_PLACED`` placed targets when there are fewer than 2 of them."""
     if text is None:
-        if len(usable) >= MIN_TARGETS:
-            return tuple(sorted(usable)), NAMED
+        if len(in_room) >= MIN_TARGETS:
+            return tuple(sorted(in_room)), NAMED
         return placed_names(DEFAULT_PLACED), PLACED
     if text.strip().isdigit():
         count = int(text)
@@ -189,6 +205,24 @@ def choose_targets(text: str | None, world: World, usable: Mapping[str, Pose2D])
     if len(names) < MIN_TARGETS:
         raise ValueError(f"targets: at least {MIN_TARGETS} are needed, {text!r} gives {len(names)}")
     return names, NAMED
+
+
+def placeable(world: World, names: tuple[str, ...], room: FloorGrid, *, fewer: bool,
+              seeds: Sequence[int] = (0,)) -> tuple[str, ...]:
+    """``names`` when every one of ``seeds`` places them all in the learning's room; with ``fewer``
+    (the default count, not one the user gave) as many as they all place, down to ``MIN_TARGETS``
+    (`clinic`'s room holds 3, `flat`'s 3 for seed 0 and 2 for seed 1); else ``ValueError`` with
+    the problem."""
+    count = len(names)
+    while True:
+        try:
+            for seed in seeds:
+                place_targets(world, count, seed, grid=room)
+            return placed_names(count)
+        except ValueError:
+            if not fewer or count <= MIN_TARGETS:
+                raise
+            count -= 1
 
 
 def placed_names(count: int) -> tuple[str, ...]:
@@ -448,11 +482,19 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     loaded, settings = options.checked or (check_world(options.world), check_options(options.world, options.extra))
     world = absolute_if_file(options.world)  # episodes run in other processes
     folder = Path(options.results_dir).resolve()
-    grid = reachable_grid(loaded)  # once: every seed's placed targets and random starts
-    targets = {seed: seed_targets(world, loaded, settings, seed, folder, grid) for seed in options.seeds}
-    truth = {seed: t.poses for seed, t in targets.items()}
-    navigate_in, people = navigation_worlds(loaded, settings, targets, folder, grid)
+    grid = reachable_grid(loaded)
     moved = _moved_start(loaded, grid)
+    room = learning_room(loaded, grid, moved or loaded.start)  # once: every seed's starts
+    inner = learning_room(loaded, grid, moved or loaded.start, inner=True) if settings.source == PLACED else room
+    if settings.fewer:  # as many as every seed places (check_options tried seed 0)
+        try:
+            settings = replace(settings, targets=placeable(loaded, settings.targets, inner, fewer=True,
+                                                           seeds=options.seeds))
+        except ValueError as exc:
+            raise SweepInputError(str(exc)) from None
+    targets = {seed: seed_targets(world, loaded, settings, seed, folder, inner) for seed in options.seeds}
+    truth = {seed: t.poses for seed, t in targets.items()}
+    navigate_in, people = navigation_worlds(loaded, settings, targets, folder, room)
     hidden = {seed: out_of_sight(loaded, moved or loaded.start, t.poses) for seed, t in targets.items()}
     episodes, rows = _learn_phase(options, targets, settings, folder, resume, moved)
     learns, plans = [], []
@@ -461,7 +503,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
         learns.append(figures)
         found = sorted(figures["target_errors"])
         if settings.starts and found and Path(episode.inputs["roadmap"]).is_file():
-            plans += goto_plans(episode, loaded, found, settings.starts, options.max_time_s, grid, navigate_in[seed])
+            plans += goto_plans(episode, loaded, found, settings.starts, options.max_time_s, room, navigate_in[seed])
     rows = {}
     if plans:  # every navigation at once: the pool runs them in parallel
         done = run_sweep([p.episode for p in plans], executor=options.executor, results_dir=folder,
@@ -509,7 +551,7 @@ def format_table(figures: Mapping[str, Any]) -> str:
                                                                for n, (x, y, deg) in by_name.items())
                   for seed, by_name in f["targets.poses"].items()]
     lines += [f"seed {seed}: {', '.join(names)} out of sight of where the learning starts, behind a wall: the "
-              "roadmap learns the targets of the room it starts in (give --option targets=... in that room)"
+              "roadmap learns the targets of the room it starts in (without --option targets it takes those)"
               for seed, names in f.get("targets.out_of_sight", {}).items() if names]
     lines += crowd.table_line(f)
     lines += [f"seed {x['seed']} {x['episode']}: {x['status']}: {x['reason']}" for x in f["failures"]]

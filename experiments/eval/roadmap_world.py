@@ -42,6 +42,7 @@ Everything is drawn from the seed alone.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import io
 import math
 from collections.abc import Callable, Iterable, Mapping
@@ -56,7 +57,7 @@ from scipy import ndimage
 
 from behaviours.roadmap.room import RoomEstimationDodecagon
 from drivers.sim.cameras import camera_pose
-from drivers.sim.floor import FloorGrid, reachable_floor
+from drivers.sim.floor import FloorGrid, rasterise, reachable_floor
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, load_world, shipped_worlds
 from maps.room import corner_circle
@@ -78,6 +79,8 @@ DODECAGON_MARGIN = 0.35  # m spare round the dodecagon at a moved start: the mon
 SIGHT_HEIGHT = 2.0  # m: a line of sight this high passes over desks, cabinets and people; walls and pillars stop it
 SIGHT_SPREAD = 0.3  # m: ... drawn to the target and this far to each side of it: a pillar does not hide all three
 LEARN_HEADINGS = 12  # headings tried at each place for a learning start (every 30 deg)
+EXIT_MARGIN = 0.45  # m: a placed target is farther than this from floor outside its room (the far side of a wall: 0.52)
+ROOM_NECK = 0.4  # m: floor in sight narrower than twice this (a door up to 1.3 m for the Pioneer) parts two rooms
 
 T = TypeVar("T")
 
@@ -374,17 +377,68 @@ def out_of_sight(world: World, start: Pose2D, targets: Mapping[str, Pose2D]) -> 
     :data:`SIGHT_HEIGHT` to the target and :data:`SIGHT_SPREAD` to each side of it all meet a wall or
     a pillar (the scene's own occlusion test). The roadmap learns the targets of the room it starts
     in (the paper's method); one in another room is not found, and the evaluation says so."""
-    scene = Scene(world)
-    eye = np.array([start.x, start.y, SIGHT_HEIGHT])
-    hidden = []
-    for name, pose in targets.items():
-        away = np.array([pose.x - start.x, pose.y - start.y])
-        across = np.array([-away[1], away[0]]) / max(float(np.hypot(*away)), 1e-9)
-        ends = [[pose.x + k * SIGHT_SPREAD * across[0], pose.y + k * SIGHT_SPREAD * across[1], SIGHT_HEIGHT]
-                for k in (-1.0, 0.0, 1.0)]
-        if scene.occluded(eye, np.array(ends)).all():
-            hidden.append(name)
-    return tuple(sorted(hidden))
+    names = sorted(targets)
+    if not names:
+        return ()
+    seen = in_sight(Scene(world), start, np.array([[targets[n].x, targets[n].y] for n in names]))
+    return tuple(n for n, ok in zip(names, seen, strict=True) if not ok)
+
+
+def in_sight(scene: Scene, eye: Pose2D, xy: np.ndarray, chunk: int = 4096) -> np.ndarray:
+    """Whether each floor point (N x 2) is in sight from ``eye``: of the lines of sight at
+    :data:`SIGHT_HEIGHT` to it and :data:`SIGHT_SPREAD` to each side of it, one meets no wall or
+    pillar (:func:`out_of_sight`'s test; ``chunk`` points at a time bound the memory)."""
+    points = np.asarray(xy, dtype=float).reshape(-1, 2)
+    origin = np.array([eye.x, eye.y, SIGHT_HEIGHT])
+    away = points - origin[:2]
+    across = np.column_stack([-away[:, 1], away[:, 0]]) / np.maximum(np.hypot(away[:, 0], away[:, 1]), 1e-9)[:, None]
+    seen = np.zeros(len(points), dtype=bool)
+    for k in (0.0, -1.0, 1.0):
+        ends = np.column_stack([points + k * SIGHT_SPREAD * across, np.full(len(points), SIGHT_HEIGHT)])
+        for i in range(0, len(points), chunk):
+            seen[i:i + chunk] |= ~scene.occluded(origin, ends[i:i + chunk])
+    return seen
+
+
+def learning_room(world: World, grid: FloorGrid, start: Pose2D,
+                  side: float = RoomEstimationDodecagon.SIDE.default, *, inner: bool = False) -> FloorGrid:
+    """The reachable floor of the room the learning starts in: ``grid`` with :attr:`~FloorGrid.reachable`
+    kept where it is :func:`in_sight` from ``start`` and joined to the dodecagon's centre by floor in
+    sight at least ``2 * ROOM_NECK`` wide between the surfaces that stop a line of sight (a
+    morphological opening: a door parts two rooms, a desk does not). The paper's method learns the
+    targets of that room and navigates in it (its room estimate is the floor the dodecagon's
+    stereo pairs see), so the evaluation draws its default targets and its navigations' starts
+    there; a world of one room keeps its floor (the lab: 99.6 %). With ``inner``, without the floor
+    within :data:`EXIT_MARGIN` of reachable floor outside the room: never in a doorway (where the
+    placed targets go: a target homed to in a doorway left the robot wedged against its jamb, the
+    corridor's walker behind it, in `office`)."""
+    tall = dataclasses.replace(world, walls=tuple(w for w in world.walls if w.height >= SIGHT_HEIGHT),
+                               pillars=tuple(p for p in world.pillars if p.height >= SIGHT_HEIGHT))
+    occupied = rasterise(tall, grid.x0, grid.y0, grid.resolution, grid.free.shape)
+    standable = ndimage.distance_transform_edt(~occupied) * grid.resolution > world.robot_radius
+    rows, cols = np.nonzero(standable)
+    cells = np.column_stack([grid.x0 + (cols + 0.5) * grid.resolution, grid.y0 + (rows + 0.5) * grid.resolution])
+    seen = np.zeros(grid.reachable.shape, dtype=bool)
+    seen[rows, cols] = in_sight(Scene(world), start, cells)
+    wide = ndimage.distance_transform_edt(seen) * grid.resolution >= ROOM_NECK
+    circle = corner_circle(side)
+    centre = np.array([[start.x - circle * math.sin(start.theta), start.y + circle * math.cos(start.theta)]])
+    (row,), (col,), (inside,) = grid.cells_of(centre)
+    parts, _ = ndimage.label(wide)
+    if inside and parts[row, col]:
+        room = (ndimage.distance_transform_edt(parts != parts[row, col]) * grid.resolution <= ROOM_NECK) & seen
+    else:  # no room for the dodecagon's circle there: the floor in sight joined to the start, not opened
+        parts, _ = ndimage.label(seen)
+        (row,), (col,), (inside,) = grid.cells_of(np.array([[start.x, start.y]]))
+        if not inside or not parts[row, col]:
+            raise ValueError(f"the learning start ({start.x:g}, {start.y:g}) is not on the reachable floor of "
+                             f"world {world.name!r}")
+        room = parts == parts[row, col]
+    room &= grid.reachable
+    exits = grid.reachable & ~room
+    if inner and exits.any():
+        room &= ndimage.distance_transform_edt(~exits) * grid.resolution > EXIT_MARGIN
+    return dataclasses.replace(grid, reachable=room)
 
 
 def has_room(grid: FloorGrid, clearance: float) -> bool:

@@ -120,3 +120,28 @@ def test_reanchoring_moves_the_reference_only():
     assert np.array_equal(moved.polygon, room.polygon)
     origin = moved.to_reference(Pose2D(0.3, 0.1, 0.2))  # the new reference pose is the frame's origin
     assert (origin.x, origin.y, origin.theta) == pytest.approx((0.0, 0.0, 0.0))
+
+
+# two 2 x 2 m rooms joined by a neck 0.4 m wide (x 2-2.5): two free regions for a 0.28 m disc
+DUMBBELL = np.array([[0, 0], [2, 0], [2, 0.8], [2.5, 0.8], [2.5, 0], [4.5, 0], [4.5, 2], [2.5, 2], [2.5, 1.2],
+                     [2, 1.2], [2, 2], [0, 2]], dtype=float)
+
+
+def test_a_robot_cut_off_from_the_goal_plans_from_the_nearest_floor_joined_to_it():
+    """The robot stands in the west room (it got there by homing, or the cut was a person who has
+    gone); the goal is in the east room. The plan starts on the east room's floor nearest the
+    robot: just inside the neck's east end, 0.28 m (the radius) and a cell's margin past x = 2.5,
+    level with the robot."""
+    room = RoomEstimate(DUMBBELL, np.array([1.0, 1.0]), Pose2D())
+    free = room.free
+    assert free.region_at(np.array([[1.0, 1.0]]), 0.28)[0] != free.region_at(np.array([[3.5, 1.0]]), 0.28)[0]
+    harness = BehaviourHarness(Planner(room, Pose2D(3.5, 1.0)), blackboard=start(room, 1.0, 1.0))
+    assert harness.tick_until(between=integrate) == Status.SUCCESS
+    first = harness.behaviour.path.waypoints[0]
+    assert free.region_at(np.array([[first.x, first.y]]), 0.28)[0] == free.region_at(np.array([[3.5, 1.0]]), 0.28)[0]
+    assert 2.78 < first.x < 2.95 and first.y == pytest.approx(1.0, abs=0.05)
+    # a goal in the robot's own room: planned from where it stands, as before
+    harness = BehaviourHarness(Planner(room, Pose2D(0.6, 1.5)), blackboard=start(room, 1.0, 1.0))
+    assert harness.tick_until(between=integrate) == Status.SUCCESS
+    first = harness.behaviour.path.waypoints[0]
+    assert (first.x, first.y) == pytest.approx((1.0, 1.0))

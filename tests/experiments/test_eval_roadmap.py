@@ -23,6 +23,8 @@ from experiments.eval.roadmap import (
     format_table,
     goto_figures,
     learn_figures,
+    placeable,
+    placed_names,
     reference_truth,
     seed_targets,
     summarise,
@@ -38,6 +40,8 @@ from experiments.eval.roadmap_world import (
     floor_in_view,
     has_room,
     heading_choices,
+    learn_start,
+    learning_room,
     place_targets,
     random_starts,
     reachable_grid,
@@ -71,6 +75,9 @@ BARE = re.sub(r"poses:\n(  .*\n)+", "", FURNISHED)  # no named poses
 CUPBOARD = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [1.6, 0], [1.6, 1.6], [0, 1.6]], closed: true, "
                   "height: 2.4}]\n", BARE)
 CUPBOARD = re.sub(r"(boxes|pillars): .*\n", "", CUPBOARD)
+# 2.2 x 2.2 m: room for the learning's dodecagon (a disc 1.49 m across round (1.1, 1.1)), not for 4 targets
+CLOSET = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [2.2, 0], [2.2, 2.2], [0, 2.2]], closed: true, "
+                "height: 2.4}]\n", CUPBOARD).replace("{x: 0.8, y: 0.8,", "{x: 1.1, y: 0.617,")
 # 8 x 1.2 m: nowhere 0.7 m clear, but room for targets 0.45 m clear looking along it
 GALLERY = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [8, 0], [8, 1.2], [0, 1.2]], closed: true, "
                  "height: 2.4}]\n", BARE)
@@ -371,10 +378,33 @@ def test_bad_targets_exit_2_with_one_line(world_file, capsys, option, message):
     assert len(err.splitlines()) == 1 and message in err and "Traceback" not in err
 
 
-def test_a_world_without_room_for_targets_exits_2(world_file, capsys):
+@pytest.mark.parametrize(("option", "count"), [([], 2), (["--option", "targets=4"], 4)])
+def test_a_world_without_room_for_targets_exits_2(world_file, capsys, option, count):
+    """The default asks for 4 and settles for as many as the room holds, down to 2; a count given is kept."""
+    assert main(["eval", "roadmap", "--world", str(world_file(CLOSET, "closet.yaml")), *option]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "has room for 1 target(s)" in err and f"not {count}:" in err
+
+
+def test_targets_are_drawn_in_the_room_the_learning_starts_in():
+    """The clinic's learning starts in a small room that none of its named poses is in: 4 placed
+    targets do not fit there (1.5 m apart, facing surfaces 1-5 m away), 3 do, and the navigations
+    start there too."""
+    clinic = load_world("clinic")
+    grid = reachable_grid(clinic)
+    room = learning_room(clinic, grid, learn_start(clinic, grid))
+    assert usable_poses(clinic, room) == {} and len(usable_poses(clinic, grid)) == 5
+    assert check_options("clinic", {}) == Settings(("t1", "t2", "t3"), 5, PLACED)
+    targets = place_targets(clinic, 3, 0, grid=room)
+    starts = random_starts(clinic, 5, 0, grid=room)
+    assert room.reachable_at(np.array([[p.x, p.y] for p in [*targets.values(), *starts]])).all()
+    assert check_options("lab", {}) == Settings(("centre", "corner", "door", "window"), 5)  # one room: as before
+
+
+def test_a_world_without_room_for_the_dodecagon_exits_2_before_any_placement(world_file, capsys):
     assert main(["eval", "roadmap", "--world", str(world_file(CUPBOARD, "cupboard.yaml"))]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "has room for" in err and "not 4" in err
+    assert len(err.splitlines()) == 1 and "the room estimation's dodecagon" in err and "has room for" not in err
 
 
 def test_an_open_world_exits_2_before_any_placement(capsys):
@@ -409,3 +439,20 @@ def test_a_torn_report_is_a_run_without_one(tmp_path):
     assert read_report(tmp_path, episode.id) is None
     row = {"status": "ERROR", "reason": "killed by SIGKILL"}
     assert learn_figures(0, read_report(tmp_path, episode.id), row, {})["reason"] == "killed by SIGKILL"
+
+
+def test_the_default_count_of_placed_targets_is_what_every_seed_places():
+    """`flat`'s bedroom holds 3 placed targets for seed 0 and only 2 for seed 1: the default (4,
+    fewer when they do not fit) settles on what every seed of the run places; a count given is kept,
+    and refused when a seed cannot place it."""
+    flat = load_world("flat")
+    grid = reachable_grid(flat)
+    start = learn_start(flat, grid)
+    inner = learning_room(flat, grid, start, inner=True)
+    assert placeable(flat, placed_names(4), inner, fewer=True) == placed_names(3)
+    assert placeable(flat, placed_names(3), inner, fewer=True, seeds=[0, 1]) == placed_names(2)
+    with pytest.raises(ValueError, match="has room for 2 target\\(s\\), not 3"):
+        placeable(flat, placed_names(3), inner, fewer=False, seeds=[0, 1])
+    settings = check_options("flat", {})
+    assert settings.targets == placed_names(3) and settings.fewer
+    assert not check_options("flat", {"targets": "3"}).fewer

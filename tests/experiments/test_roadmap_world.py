@@ -1,15 +1,17 @@
-"""Where the roadmap evaluation starts a learning: where the room estimation's dodecagon fits."""
+"""Where the roadmap evaluation starts a learning (where the room estimation's dodecagon fits) and the room it
+learns (the floor in sight of it, cut at the doors)."""
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 import yaml
 
 from drivers.sim.scene import Scene
 from drivers.sim.world import load_world
-from experiments.eval.roadmap_world import learn_start, out_of_sight, reachable_grid
+from experiments.eval.roadmap_world import learn_start, learning_room, out_of_sight, reachable_grid
 from perception.geometry import Pose2D
 
 CIRCLE = 0.25 / (2.0 * math.sin(math.pi / 12))  # 0.4830 m: the corners' circle of a 0.25 m side
@@ -75,3 +77,43 @@ def test_targets_behind_a_wall_are_out_of_sight_of_the_learning_start(tmp_path):
                "behind_pillar": Pose2D(3.2, 2.0, 0.0), "behind_cabinet": Pose2D(2.0, 3.6, 0.0)}
     assert out_of_sight(world, world.start, targets) == ("next_room",)
     assert out_of_sight(world, Pose2D(6.0, 1.0, 0.0), targets) == ("behind_cabinet", "behind_pillar")
+
+
+def test_the_learning_room_is_the_floor_in_sight_cut_at_the_door_and_not_at_a_desk(tmp_path):
+    """Worked by hand in TWO_ROOMS with a desk (x 2.5-3.0, y 1.0-4.0) leaving a 1.0 m gap at the
+    south wall: the robot's centre passes it in a 0.48 m strip (1.0 - 2 x 0.26), narrower than the
+    opening's 0.8 m. Low (0.75 m), the desk is looked over and does not part the room: (3.5, 3.0)
+    east of it is in the room. As tall as the walls it hides that strip (the line from the start
+    (0.8, 2.0) to (3.5, 3.0) crosses x = 2.5-3.0 at y = 2.63-2.81, and the lines 0.3 m to its sides
+    too) and it is out. (6.0, 3.4) is in sight through the 1.2 m door (the line crosses x = 4 at
+    y = 2.86), but the door's reachable floor is 0.68 m wide: the next room. (6.0, 1.0): behind
+    the wall."""
+    points = np.array([[1.0, 1.0], [3.5, 3.0], [6.0, 3.4], [6.0, 1.0]])
+    inside = {}
+    for height in (0.75, 2.4):
+        desk = {"center": [2.75, 2.5], "size": [0.5, 3.0], "height": height}
+        world = world_file(tmp_path, {**TWO_ROOMS, "name": f"desk{height:g}", "boxes": [*TWO_ROOMS["boxes"], desk]})
+        grid = reachable_grid(world)
+        assert grid.reachable_at(points).all()  # every point is floor the robot can reach from the start
+        inside[height] = learning_room(world, grid, world.start).reachable_at(points).tolist()
+    assert inside == {0.75: [True, True, False, False], 2.4: [True, False, False, False]}
+
+
+def test_a_one_room_world_keeps_its_floor_and_its_named_poses():
+    lab = load_world("lab")
+    grid = reachable_grid(lab)
+    room = learning_room(lab, grid, learn_start(lab, grid))
+    assert np.count_nonzero(room.reachable) >= 0.99 * np.count_nonzero(grid.reachable)
+    assert room.reachable_at(np.array([[p.x, p.y] for p in lab.poses.values()])).all()
+
+
+def test_placed_targets_keep_away_from_the_rooms_exits(tmp_path):
+    """In TWO_ROOMS the west room's floor reaches into the door (x 4, y 2.8-4): (3.6, 3.4) is in the
+    room, 0.4 m from the door's line, and the reachable floor beyond the room is nearer than 0.45 m
+    (the room's floor ends in the doorway): not where a target goes. (1.0, 1.0), far from the door,
+    and (3.6, 1.0), by the wall between the rooms (the floor beyond it 0.52 m and more away), are."""
+    world = world_file(tmp_path, TWO_ROOMS)
+    grid = reachable_grid(world)
+    points = np.array([[1.0, 1.0], [3.6, 1.0], [3.6, 3.4]])
+    assert learning_room(world, grid, world.start).reachable_at(points).tolist() == [True, True, True]
+    assert learning_room(world, grid, world.start, inner=True).reachable_at(points).tolist() == [True, True, False]
