@@ -61,6 +61,11 @@ class OdometryMotion(BearingsBehaviour):
     def odometry(self) -> Pose2D | None:
         return self.get_input(ODOMETRY, None)
 
+    @property
+    def held_since(self) -> float | None:
+        """Since when the collision monitor has stopped every command of this motion (None: it has not)."""
+        return self._held_since
+
     def command(self, v: float, w: float, reach: float = math.inf) -> None:
         """Write the command; ``reach``: how far the node means to go on it before its goal (m)."""
         self.set_output(COMMAND, VelocityCommand(v, w, reach))

@@ -14,6 +14,7 @@ from behaviours.roadmap.routine import CAMERA_OFFSET, ROUTINE_PORTS, Failed, Rou
 from behaviours.testing import BehaviourHarness
 from drivers.interfaces import STOP, PanTiltState
 from perception.camera import PinholeCamera
+from perception.collision_monitor import SafetyState
 from perception.frame import Frame
 from perception.geometry import Pose2D
 from tests.behaviours.test_motion import integrate
@@ -154,3 +155,25 @@ def test_written_is_what_the_node_last_wrote_on_its_output_and_none_before(key):
 def test_pair_reads_a_position_port():
     node = Errand(camera_offset=[0.2, -0.05])
     assert node.camera_offset == (0.2, -0.05) and node.pair(CAMERA_OFFSET) == (0.2, -0.05)
+
+
+def held_for(seconds: float):
+    """Between ticks: :func:`world`, and the collision monitor stopping every command (the base does
+    not move) for the first ``seconds`` (a person in the way who then walks on)."""
+    def between(harness: BehaviourHarness) -> None:
+        stopped = harness.clock.now() < seconds
+        harness.write("/robot/safety", SafetyState("stopped", "stop", "stop", "a person") if stopped else SafetyState())
+        if not stopped:
+            world(harness)
+    return between
+
+
+def test_time_held_by_the_collision_monitor_is_not_lack_of_progress():
+    """The quarter turn is given 3 x 2 s + 5 s = 11 s; held for 15 s by the monitor it still goes on
+    once the way clears, and a hold of the motion node's held_timeout (20 s) fails, saying so."""
+    harness = BehaviourHarness(Errand(), blackboard={"/robot/odometry": Pose2D()})
+    assert harness.tick_until(between=held_for(15.0), max_ticks=1000) == Status.SUCCESS
+    harness = BehaviourHarness(Errand(), blackboard={"/robot/odometry": Pose2D()})
+    assert harness.tick_until(between=held_for(1000.0), max_ticks=1000) == Status.FAILURE
+    assert "held by the collision monitor for 20 s" in harness.behaviour.feedback_message
+    assert 20.0 <= harness.clock.now() < 21.0
