@@ -295,6 +295,14 @@ def corner_circle(side: float) -> float:
     return side / (2.0 * math.sin(math.pi / CORNERS))
 
 
+def dodecagon_centre(start: Pose2D, side: float) -> tuple[float, float]:
+    """The point :func:`corner_circle` away square to the start's left: where the evaluation looks
+    for the dodecagon's room. The drive turns 30 degrees before its first side, so the corners'
+    true centre lies 15 degrees further round (0.125 m from this point for a 0.25 m side)."""
+    circle = corner_circle(side)
+    return start.x - circle * math.sin(start.theta), start.y + circle * math.cos(start.theta)
+
+
 def dodecagon(start: Pose2D, side: float) -> tuple[Pose2D, ...]:
     """The 12 corner poses of the room-estimation drive from ``start`` (same frame as start).
 

@@ -86,8 +86,8 @@ def plan(host: RoutineBehaviour, room: RoomEstimate, goal: Pose2D) -> Step[PlanR
     if start is None or end is None:
         what = "robot" if start is None else "goal"
         raise Failed(f"no path: the {what} is more than {SNAP} m from floor where the robot may stand")
-    goal_region = int(room.free.region_at(np.array([end]), radius)[0])
-    if room.free.region_at(np.array([start]), radius)[0] != goal_region:  # the robot stands cut off from the goal
+    start_region, goal_region = (int(r) for r in room.free.region_at(np.array([start, end]), radius))
+    if start_region != goal_region:  # the robot stands cut off from the goal
         start = nearest_standable(room.free, here.x, here.y, radius, snap=math.inf, region=goal_region)
         assert start is not None  # the goal's own cell is in its region
     limit = host.get_input(PLAN_TIME_IN) if PLAN_TIME_IN.name in host.inputs else PLAN_TIME

@@ -79,6 +79,7 @@ from experiments.eval import EvalOptions, count_option
 from experiments.eval import people as crowd
 from experiments.eval.figures import cell, interval_cell, mean_present, safety_cells, safety_figures, safety_totals
 from experiments.eval.roadmap_world import (
+    away_from_exits,
     learn_start,
     learning_room,
     out_of_sight,
@@ -176,10 +177,9 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
     room = learning_room(loaded, grid, start)
     targets, source = choose_targets(extra.get("targets"), loaded, usable_poses(loaded, grid),
                                      usable_poses(loaded, room))
+    fewer = source == PLACED and extra.get("targets") is None  # the default count: as many as fit
     if source == PLACED:
-        inner = learning_room(loaded, grid, start, inner=True)
-        targets = placeable(loaded, targets, inner, fewer=extra.get("targets") is None)
-    fewer = source == PLACED and extra.get("targets") is None
+        targets = placeable(loaded, targets, away_from_exits(room, grid), fewer=fewer)
     starts = parse_starts(extra.get("starts"))
     if starts:
         random_starts(loaded, 1, 0, grid=room)  # ValueError: nowhere clear enough to start from
@@ -485,7 +485,7 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     grid = reachable_grid(loaded)
     moved = _moved_start(loaded, grid)
     room = learning_room(loaded, grid, moved or loaded.start)  # once: every seed's starts
-    inner = learning_room(loaded, grid, moved or loaded.start, inner=True) if settings.source == PLACED else room
+    inner = away_from_exits(room, grid) if settings.source == PLACED else room
     if settings.fewer:  # as many as every seed places (check_options tried seed 0)
         try:
             settings = replace(settings, targets=placeable(loaded, settings.targets, inner, fewer=True,

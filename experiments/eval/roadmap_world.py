@@ -60,7 +60,7 @@ from drivers.sim.cameras import camera_pose
 from drivers.sim.floor import FloorGrid, rasterise, reachable_floor
 from drivers.sim.scene import Scene
 from drivers.sim.world import World, load_world, shipped_worlds
-from maps.room import corner_circle
+from maps.room import corner_circle, dodecagon_centre
 from missions.cli import main
 from perception.geometry import Pose2D, wrap_angle, wrap_angles
 
@@ -265,7 +265,12 @@ def camera_view(scene: Scene, world: World, pose: Pose2D, azimuths: np.ndarray, 
 
 def floor_cells(grid: FloorGrid) -> np.ndarray:
     """World (x, y) of the centres of the grid's reachable cells (N x 2): where the robot can stand."""
-    rows, cols = np.nonzero(grid.reachable)
+    return cell_centres(grid, grid.reachable)
+
+
+def cell_centres(grid: FloorGrid, mask: np.ndarray) -> np.ndarray:
+    """World (x, y) of the centres of the cells of ``mask`` (the grid's shape), N x 2, row by row."""
+    rows, cols = np.nonzero(mask)
     return np.column_stack([grid.x0 + (cols + 0.5) * grid.resolution, grid.y0 + (rows + 0.5) * grid.resolution])
 
 
@@ -349,12 +354,8 @@ def learn_start(world: World, grid: FloorGrid, side: float = RoomEstimationDodec
     when no reachable place has the room."""
     circle = corner_circle(side)
     scene = Scene(world)
-
-    def centre(x: float, y: float, theta: float) -> tuple[float, float]:
-        return x - circle * math.sin(theta), y + circle * math.cos(theta)
-
     start = world.start
-    if scene.clearance(*centre(start.x, start.y, start.theta)) >= circle + world.robot_radius:
+    if scene.clearance(*dodecagon_centre(start, side)) >= circle + world.robot_radius:
         return Pose2D(start.x, start.y, start.theta)
     need = circle + world.robot_radius + DODECAGON_MARGIN
     room = ndimage.distance_transform_edt(grid.free) * grid.resolution  # generous by a cell: exact check below
@@ -363,7 +364,7 @@ def learn_start(world: World, grid: FloorGrid, side: float = RoomEstimationDodec
         x, y = (float(c) for c in cells[i])
         for k in range(LEARN_HEADINGS):
             theta = wrap_angle(start.theta + 2.0 * math.pi * k / LEARN_HEADINGS)
-            cx, cy = centre(x, y, theta)
+            cx, cy = dodecagon_centre(Pose2D(x, y, theta), side)
             col, row = int((cx - grid.x0) / grid.resolution), int((cy - grid.y0) / grid.resolution)
             inside = 0 <= row < room.shape[0] and 0 <= col < room.shape[1]
             if inside and room[row, col] + grid.resolution >= need and scene.clearance(cx, cy) >= need:
@@ -401,29 +402,22 @@ def in_sight(scene: Scene, eye: Pose2D, xy: np.ndarray, chunk: int = 4096) -> np
 
 
 def learning_room(world: World, grid: FloorGrid, start: Pose2D,
-                  side: float = RoomEstimationDodecagon.SIDE.default, *, inner: bool = False) -> FloorGrid:
+                  side: float = RoomEstimationDodecagon.SIDE.default) -> FloorGrid:
     """The reachable floor of the room the learning starts in: ``grid`` with :attr:`~FloorGrid.reachable`
     kept where it is :func:`in_sight` from ``start`` and joined to the dodecagon's centre by floor in
     sight at least ``2 * ROOM_NECK`` wide between the surfaces that stop a line of sight (a
     morphological opening: a door parts two rooms, a desk does not). The paper's method learns the
     targets of that room and navigates in it (its room estimate is the floor the dodecagon's
     stereo pairs see), so the evaluation draws its default targets and its navigations' starts
-    there; a world of one room keeps its floor (the lab: 99.6 %). With ``inner``, without the floor
-    within :data:`EXIT_MARGIN` of reachable floor outside the room: never in a doorway (where the
-    placed targets go: a target homed to in a doorway left the robot wedged against its jamb, the
-    corridor's walker behind it, in `office`)."""
+    there; a world of one room keeps its floor (the lab: 99.6 %)."""
     tall = dataclasses.replace(world, walls=tuple(w for w in world.walls if w.height >= SIGHT_HEIGHT),
                                pillars=tuple(p for p in world.pillars if p.height >= SIGHT_HEIGHT))
     occupied = rasterise(tall, grid.x0, grid.y0, grid.resolution, grid.free.shape)
     standable = ndimage.distance_transform_edt(~occupied) * grid.resolution > world.robot_radius
-    rows, cols = np.nonzero(standable)
-    cells = np.column_stack([grid.x0 + (cols + 0.5) * grid.resolution, grid.y0 + (rows + 0.5) * grid.resolution])
     seen = np.zeros(grid.reachable.shape, dtype=bool)
-    seen[rows, cols] = in_sight(Scene(world), start, cells)
+    seen[standable] = in_sight(Scene(world), start, cell_centres(grid, standable))
     wide = ndimage.distance_transform_edt(seen) * grid.resolution >= ROOM_NECK
-    circle = corner_circle(side)
-    centre = np.array([[start.x - circle * math.sin(start.theta), start.y + circle * math.cos(start.theta)]])
-    (row,), (col,), (inside,) = grid.cells_of(centre)
+    (row,), (col,), (inside,) = grid.cells_of(np.array([dodecagon_centre(start, side)]))
     parts, _ = ndimage.label(wide)
     if inside and parts[row, col]:
         room = (ndimage.distance_transform_edt(parts != parts[row, col]) * grid.resolution <= ROOM_NECK) & seen
@@ -434,11 +428,19 @@ def learning_room(world: World, grid: FloorGrid, start: Pose2D,
             raise ValueError(f"the learning start ({start.x:g}, {start.y:g}) is not on the reachable floor of "
                              f"world {world.name!r}")
         room = parts == parts[row, col]
-    room &= grid.reachable
-    exits = grid.reachable & ~room
-    if inner and exits.any():
-        room &= ndimage.distance_transform_edt(~exits) * grid.resolution > EXIT_MARGIN
-    return dataclasses.replace(grid, reachable=room)
+    return dataclasses.replace(grid, reachable=room & grid.reachable)
+
+
+def away_from_exits(room: FloorGrid, grid: FloorGrid) -> FloorGrid:
+    """``room`` (:func:`learning_room` of ``grid``) without its floor within :data:`EXIT_MARGIN` of
+    reachable floor outside it: never in a doorway. Where the placed targets go: a target homed to
+    in a doorway left the robot wedged against its jamb, the corridor's walker behind it, in
+    `office`."""
+    exits = grid.reachable & ~room.reachable
+    if not exits.any():
+        return room
+    return dataclasses.replace(room, reachable=room.reachable
+                               & (ndimage.distance_transform_edt(~exits) * grid.resolution > EXIT_MARGIN))
 
 
 def has_room(grid: FloorGrid, clearance: float) -> bool:

@@ -34,6 +34,7 @@ from experiments.eval.roadmap_world import (
     START_CLEARANCE,
     TARGET_CLEARANCE,
     FreeFloor,
+    away_from_exits,
     best_heading,
     camera_rays,
     camera_view,
@@ -448,7 +449,7 @@ def test_the_default_count_of_placed_targets_is_what_every_seed_places():
     flat = load_world("flat")
     grid = reachable_grid(flat)
     start = learn_start(flat, grid)
-    inner = learning_room(flat, grid, start, inner=True)
+    inner = away_from_exits(learning_room(flat, grid, start), grid)
     assert placeable(flat, placed_names(4), inner, fewer=True) == placed_names(3)
     assert placeable(flat, placed_names(3), inner, fewer=True, seeds=[0, 1]) == placed_names(2)
     with pytest.raises(ValueError, match="has room for 2 target\\(s\\), not 3"):

@@ -11,7 +11,7 @@ import yaml
 
 from drivers.sim.scene import Scene
 from drivers.sim.world import load_world
-from experiments.eval.roadmap_world import learn_start, learning_room, out_of_sight, reachable_grid
+from experiments.eval.roadmap_world import away_from_exits, learn_start, learning_room, out_of_sight, reachable_grid
 from perception.geometry import Pose2D
 
 CIRCLE = 0.25 / (2.0 * math.sin(math.pi / 12))  # 0.4830 m: the corners' circle of a 0.25 m side
@@ -115,5 +115,6 @@ def test_placed_targets_keep_away_from_the_rooms_exits(tmp_path):
     world = world_file(tmp_path, TWO_ROOMS)
     grid = reachable_grid(world)
     points = np.array([[1.0, 1.0], [3.6, 1.0], [3.6, 3.4]])
-    assert learning_room(world, grid, world.start).reachable_at(points).tolist() == [True, True, True]
-    assert learning_room(world, grid, world.start, inner=True).reachable_at(points).tolist() == [True, True, False]
+    room = learning_room(world, grid, world.start)
+    assert room.reachable_at(points).tolist() == [True, True, True]
+    assert away_from_exits(room, grid).reachable_at(points).tolist() == [True, True, False]

@@ -18,6 +18,7 @@ from maps.room import (
     RoomParams,
     StereoView,
     dodecagon,
+    dodecagon_centre,
     estimate_room,
     reference_index,
 )
@@ -182,3 +183,12 @@ def test_standing_is_conservative(seed, radius, fx, fy):
     centres = np.asarray(grid.origin) + blocked * grid.cell
     gap = np.maximum(np.abs(p - centres) - grid.cell / 2, 0.0)
     assert np.hypot(gap[:, 0], gap[:, 1]).min() >= radius
+
+
+def test_the_dodecagon_centre_is_the_corners_circle_radius_to_the_start_s_left():
+    """Worked by hand: side 0.25 m, circle 0.25 / (2 sin 15 deg) = 0.48296 m; facing +y (90 deg) the
+    left is -x. (The drive turns before its first side, so the corners' true centre lies 15 degrees
+    further round, at 105 degrees, 0.125 m from this point: see the note on issue 21.)"""
+    assert dodecagon_centre(Pose2D(1.0, 2.0, math.pi / 2), 0.25) == pytest.approx((1.0 - 0.48296, 2.0), abs=1e-5)
+    corners = np.array([[c.x, c.y] for c in dodecagon(Pose2D(), 0.25)])
+    assert corners.mean(axis=0) == pytest.approx((-0.125, 0.46651), abs=1e-5)  # 0.48296 at 105 deg
