@@ -70,6 +70,7 @@ WATCHDOG_S = 2.0
 """The simulated base stops when no command arrives for this long, as a Pioneer's firmware does
 (its config packet's Watchdog, 2000 ms; docs/protocols.md): a mission that leaves the base to run
 on without commands stops in the simulator as it would on the robot."""
+REPORTED_CONTACTS = 20  # collisions listed with their time and place in the report (all are counted)
 
 
 class SimBase:
@@ -139,6 +140,8 @@ class Simulation:
         self._stalled_time = 0.0
         self.drive = DiffDrive(start=start or self.world.start, limits=limits, slip=slip, rng=self.rng)
         self.min_clearance = self._clearance(*self.drive.true_pose[:2]) - self.world.robot_radius
+        self._nearest_at: dict[str, Any] | None = None  # when and where the clearance was least, and to what
+        self._contacts: list[dict[str, Any]] = []  # when and where each collision began, and with what
         self.ptu = SimPanTilt(self.world.ptu, clock=lambda: self.time)
         self.lighting = run_lighting(self.world.lighting, np.random.default_rng(streams[0]))
         self.cameras: dict[str, SimCamera] = {}
@@ -202,6 +205,7 @@ class Simulation:
             if not self._in_contact:  # a new contact episode (not the same push, step after step)
                 self.collisions += 1
                 self.collisions_with_people += int(by_person)
+                self._contacts.append(self._where(self.time + dt, "person" if by_person else "surface"))
             self.stalled = self._in_contact = True
         else:
             self.stalled = False
@@ -212,9 +216,18 @@ class Simulation:
         self.scene.move_people(self.crowd.xy)
         self.ptu.step(dt)
         self.time += dt
-        here = min(fixed_at_end, self.crowd.clearance(*drive.true_pose[:2]))  # the people have moved
-        self.min_clearance = min(self.min_clearance, here - radius)
+        person = self.crowd.clearance(*drive.true_pose[:2])  # the people have moved
+        here = min(fixed_at_end, person)
+        if here - radius < self.min_clearance:
+            self.min_clearance = here - radius
+            self._nearest_at = self._where(self.time, "person" if person < fixed_at_end else "surface")
         self.truth.record(self.time, drive.true(self.time), drive.odometry(self.time))
+
+    def _where(self, t: float, what: str) -> dict[str, Any]:
+        """The time, the robot's true place and what it met, for the report."""
+        x, y, theta = (float(v) for v in self.drive.true_pose[:3])
+        return {"t": round(t, 2), "x": round(x, 3), "y": round(y, 3), "theta_deg": round(math.degrees(theta), 1),
+                "with": what}
 
     def _clearance(self, x: float, y: float) -> float:
         """Distance (m) from (x, y) to the nearest wall, box face, pillar or person."""
@@ -297,7 +310,10 @@ class Simulation:
         contact episode: the robot ran into something), ``collisions_with_people`` (those of them
         with a person; people stop for the robot, so a contact is always the robot's doing),
         ``min_clearance_m`` (the smallest distance from the robot's disc to any wall, box, pillar
-        or person over the run; None in a world with nothing in it), ``stalled_time_s``,
+        or person over the run; None in a world with nothing in it), ``min_clearance_at`` (when,
+        where the robot was, and whether a ``person`` or a ``surface``; None when the start was the
+        nearest), ``collisions_at`` (the same for the first :data:`REPORTED_CONTACTS` collisions),
+        ``stalled_time_s``,
         ``trajectory`` (decimated), ``stops`` (every stretch the robot stood still, exactly: see
         :func:`_stops`) and the true ``landmarks``; with ``goal``
         (x, y): ``goal_error_m``; with a ``reference_path`` of (x, y) points: ``path_error_m``
@@ -322,6 +338,8 @@ class Simulation:
             "collisions": int(self.collisions),
             "collisions_with_people": int(self.collisions_with_people),
             "min_clearance_m": float(self.min_clearance) if math.isfinite(self.min_clearance) else None,
+            "min_clearance_at": self._nearest_at,
+            "collisions_at": self._contacts[:REPORTED_CONTACTS],
             "stalled_time_s": float(self._stalled_time),
             "trajectory": _decimate(true, max_points=2000),
             "stops": _stops(true),

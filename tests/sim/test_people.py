@@ -112,6 +112,12 @@ def test_driving_into_a_standing_person_is_a_collision_with_a_person(sim_from):
     report = sim.ground_truth_report()
     assert report["collisions"] == 1 and report["collisions_with_people"] == 1
     assert report["min_clearance_m"] == pytest.approx(0.0, abs=0.001)
+    # said with its time and place: 0.95 m at 0.4 m/s (the base accelerating at ARIA's 0.3 m/s^2 for the
+    # first 1.33 s, 0.267 m of them): (0.95 - 0.267) / 0.4 + 1.33 = 3.04 s
+    contact = report["collisions_at"][0]
+    assert contact["with"] == "person" and contact["x"] == pytest.approx(0.95, abs=0.001)
+    assert contact["t"] == pytest.approx(3.04, abs=0.11)  # within a step
+    assert report["min_clearance_at"]["with"] == "person"
 
 
 def test_a_person_hides_a_landmark_behind_them_from_the_bearings_sensor(sim_from):
