@@ -296,11 +296,13 @@ def corner_circle(side: float) -> float:
 
 
 def dodecagon_centre(start: Pose2D, side: float) -> tuple[float, float]:
-    """The point :func:`corner_circle` away square to the start's left: where the evaluation looks
-    for the dodecagon's room. The drive turns 30 degrees before its first side, so the corners'
-    true centre lies 15 degrees further round (0.125 m from this point for a 0.25 m side)."""
+    """The centre of the room-estimation drive's corners from ``start``: the drive turns 30 degrees
+    before its first side, so the centre lies :func:`corner_circle` away at 90 + 15 = 105 degrees
+    to the start's heading (the angle between a side and the radius at its first corner is 75
+    degrees). Until stop 49 this was taken square to the left, 0.125 m off for a 0.25 m side."""
     circle = corner_circle(side)
-    return start.x - circle * math.sin(start.theta), start.y + circle * math.cos(start.theta)
+    bearing = start.theta + math.pi / 2.0 + math.pi / CORNERS
+    return start.x + circle * math.cos(bearing), start.y + circle * math.sin(bearing)
 
 
 def dodecagon(start: Pose2D, side: float) -> tuple[Pose2D, ...]:

@@ -119,8 +119,9 @@ class RoomEstimationDodecagon(RoutineBehaviour):
         circle = corner_circle(side)
         disc = robot_radius(self, 0.0)
         return (f"the dodecagon (side {side:.2f} m) needs a free disc {2.0 * (circle + disc):.2f} m across, its "
-                f"centre {circle:.2f} m to the robot's left at the start (corners on a {circle:.2f} m circle, the "
-                f"robot's disc {disc:.2f} m): start the robot in open floor, or give a smaller side")
+                f"centre {circle:.2f} m to the robot's left at the start, 105 deg round from its heading "
+                f"(corners on a {circle:.2f} m circle, the robot's disc {disc:.2f} m): start the robot in open "
+                "floor, or give a smaller side")
 
     def routine(self) -> Step[None]:
         stereo, camera = self.get_input(self.STEREO_CAMERA), self.get_input(CAMERA)

@@ -345,9 +345,10 @@ def best_heading(free: FreeFloor, x: float, y: float, azimuths: np.ndarray, *,
 def learn_start(world: World, grid: FloorGrid, side: float = RoomEstimationDodecagon.SIDE.default) -> Pose2D:
     """Where ``learn_targets`` starts: the world's start when the room estimation's dodecagon fits
     there (the robot's disc clears every surface all round the corners' circle, whose centre lies
-    side / (2 sin 15 deg) to the robot's left), else the reachable pose nearest to it where it does
-    with :data:`DODECAGON_MARGIN` to spare (the lab's start has 0.06 m and is kept; a start moved
-    is moved to where the collision monitor neither stops nor slows the drives: with 0.10 m, its
+    side / (2 sin 15 deg) away, 105 deg round from the start's heading: ``maps.room.dodecagon_centre``),
+    else the reachable pose nearest to it where it does with :data:`DODECAGON_MARGIN` to spare (the lab's
+    start has 0.02 m and is kept; a start moved is moved to where the collision monitor neither stops
+    nor slows the drives: with 0.10 m, its
     stop margin, `flat`'s learning was stopped at the tenth corner). The method expects the
     robot in a room (the paper's); a world may start it in a hallway (``flat``: 1.4 m wide, where
     the learning was stopped at its fourth corner), and a user would carry it into a room. ValueError

@@ -58,7 +58,7 @@ from tests.missions.test_roadmap_missions import SMALL_ROOM
 # one inside the box, one in the pillar's reach
 FURNISHED = """
 name: furnished
-start: {x: 0.8, y: 0.8, theta_deg: 0}
+start: {x: 0.9, y: 0.8, theta_deg: 0}
 poses:
   p: {x: 1.0, y: 3.0, theta_deg: 0}
   q: {x: 5.0, y: 0.8, theta_deg: 90}
@@ -78,11 +78,11 @@ CUPBOARD = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [1.6, 0], [1.6, 1.6
 CUPBOARD = re.sub(r"(boxes|pillars): .*\n", "", CUPBOARD)
 # 2.2 x 2.2 m: room for the learning's dodecagon (a disc 1.49 m across round (1.1, 1.1)), not for 4 targets
 CLOSET = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [2.2, 0], [2.2, 2.2], [0, 2.2]], closed: true, "
-                "height: 2.4}]\n", CUPBOARD).replace("{x: 0.8, y: 0.8,", "{x: 1.1, y: 0.617,")
+                "height: 2.4}]\n", CUPBOARD).replace("{x: 0.9, y: 0.8,", "{x: 1.225, y: 0.634,")
 # 8 x 1.2 m: nowhere 0.7 m clear, but room for targets 0.45 m clear looking along it
 GALLERY = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [8, 0], [8, 1.2], [0, 1.2]], closed: true, "
                  "height: 2.4}]\n", BARE)
-GALLERY = re.sub(r"(boxes|pillars): .*\n", "", GALLERY).replace("{x: 0.8, y: 0.8,", "{x: 0.8, y: 0.6,")
+GALLERY = re.sub(r"(boxes|pillars): .*\n", "", GALLERY).replace("{x: 0.9, y: 0.8,", "{x: 0.9, y: 0.6,")
 # 6 x 6 m, empty: the floor in view has a closed form
 EMPTY = re.sub(r"walls: .*\n", "walls: [{points: [[0, 0], [6, 0], [6, 6], [0, 6]], closed: true, height: 2.4}]\n",
                BARE)

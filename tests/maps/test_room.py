@@ -185,10 +185,11 @@ def test_standing_is_conservative(seed, radius, fx, fy):
     assert np.hypot(gap[:, 0], gap[:, 1]).min() >= radius
 
 
-def test_the_dodecagon_centre_is_the_corners_circle_radius_to_the_start_s_left():
+def test_the_dodecagon_centre_is_the_corners_circle_radius_at_105_degrees_to_the_start_heading():
     """Worked by hand: side 0.25 m, circle 0.25 / (2 sin 15 deg) = 0.48296 m; facing +y (90 deg) the
-    left is -x. (The drive turns before its first side, so the corners' true centre lies 15 degrees
-    further round, at 105 degrees, 0.125 m from this point: see the note on issue 21.)"""
-    assert dodecagon_centre(Pose2D(1.0, 2.0, math.pi / 2), 0.25) == pytest.approx((1.0 - 0.48296, 2.0), abs=1e-5)
+    centre lies at 195 deg: (1 + 0.48296 cos 195, 2 + 0.48296 sin 195) = (0.53349, 1.87500). From
+    the origin facing +x, at 105 deg: (-0.12500, 0.46651), the mean of the drive's 12 corners."""
+    assert dodecagon_centre(Pose2D(1.0, 2.0, math.pi / 2), 0.25) == pytest.approx((0.53349, 1.87500), abs=1e-5)
     corners = np.array([[c.x, c.y] for c in dodecagon(Pose2D(), 0.25)])
-    assert corners.mean(axis=0) == pytest.approx((-0.125, 0.46651), abs=1e-5)  # 0.48296 at 105 deg
+    assert corners.mean(axis=0) == pytest.approx((-0.125, 0.46651), abs=1e-5)
+    assert dodecagon_centre(Pose2D(), 0.25) == pytest.approx((-0.125, 0.46651), abs=1e-5)
