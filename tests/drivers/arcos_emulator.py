@@ -205,7 +205,7 @@ class ArcosEmulator(EmulatorThread):
     def first_after(self, name: str, t: float) -> Event | None:
         return next((e for e in self.named(name) if e.t >= t), None)
 
-    def wait_for(self, predicate, timeout: float = 2.0) -> bool:
+    def wait_for(self, predicate, timeout: float = 5.0) -> bool:
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             if predicate():

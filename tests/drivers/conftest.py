@@ -20,7 +20,7 @@ from tests.drivers.ptu_emulator import PtuEmulator
 E = TypeVar("E", ArcosEmulator, PtuEmulator)
 
 FAST_EMULATOR = {"sip_period": 0.02}
-FAST_BASE = {"sip_timeout": 0.2, "resend_period": 0.05, "reply_timeout": 0.1, "connect_timeout": 2.0,
+FAST_BASE = {"sip_timeout": 0.2, "resend_period": 0.05, "reply_timeout": 0.1, "connect_timeout": 8.0,
              "command_timeout": 5.0}
 FAST_PTU = {"reply_timeout": 0.2, "poll_period": 0.03, "init_settle": 0.04}
 

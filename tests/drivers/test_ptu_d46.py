@@ -198,9 +198,9 @@ def test_a_unit_that_resets_and_homes_mid_session_goes_back_to_its_target(ptu):
     assert _wait(lambda: not pan_tilt.state().moving)
     target = pan_tilt.positions()
     emulator.home(duration=1.0)  # five times the reply timeout, more than max_timeouts replies missed
-    assert _wait(lambda: pan_tilt.homings == 1, timeout=3.0)
+    assert _wait(lambda: pan_tilt.homings == 1, timeout=6.0)
     assert [c for c in emulator.commands if c.ignored]  # it did ask, and was not answered, meanwhile
-    assert _wait(lambda: not pan_tilt.state().moving and pan_tilt.positions() == target, timeout=3.0)
+    assert _wait(lambda: not pan_tilt.state().moving and pan_tilt.positions() == target, timeout=6.0)
     assert pan_tilt.state() is not None  # no PtuError was waiting
     assert pan_tilt.fault is None and pan_tilt.errors == 0 and pan_tilt.limit_hits == 4
     assert emulator.homings == 1 and emulator.position() == pytest.approx(target, abs=1)  # where it was sent
@@ -259,7 +259,7 @@ def test_open_errors(tmp_path, ptu_emulator):
     assert all(p.get("description") for p in schema.values())
 
 
-def _wait(predicate, timeout: float = 2.0) -> bool:
+def _wait(predicate, timeout: float = 5.0) -> bool:
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         if predicate():
