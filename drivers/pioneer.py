@@ -92,6 +92,7 @@ class BaseStatus:
     motors_enabled: bool = False
     estop: bool = False
     sonar: tuple[tuple[int, float], ...] = ()  # (index, range m), every sonar seen so far
+    sonar_fired: tuple[tuple[int, float], ...] = ()  # (index, stamp of the SIP that last reported it)
     silent_sonar: frozenset[int] = frozenset()  # indices not heard for sonar_timeout
     sips: int = 0
     stamp: float = 0.0
@@ -136,6 +137,7 @@ class PioneerBase:
         self._status: BaseStatus | None = None
         self._sonar: dict[int, float] = {}
         self._sonar_heard: dict[int, float] = {}  # index -> time.monotonic() of its last reading
+        self._sonar_fired: dict[int, float] = {}  # index -> the stamp of the SIP that last reported it
         self._sips = 0  # SIPs decoded since the base was built
         self._target = (0.0, 0.0)  # mm/s, deg/s
         self._wake = threading.Event()
@@ -248,7 +250,7 @@ class PioneerBase:
         """The newest SIP's sonar readings and bumpers as one scan, stamped when the SIP arrived."""
         status = self._current()
         return self.body().scan(dict(status.sonar), status.silent_sonar, status.front_bumpers, status.rear_bumpers,
-                                status.stamp, with_sonar=self.settings.sonar)
+                                status.stamp, with_sonar=self.settings.sonar, fired=dict(status.sonar_fired))
 
     def range_source(self) -> PioneerRanges:
         """This base's sonar ring and bumpers as the robot's range source."""
@@ -459,12 +461,13 @@ class PioneerBase:
             self._odometry = Odometry(params)
         x, y, theta = self._odometry.update(sip)
         heard = time.monotonic()
+        stamp = self._stamp()
         for index, raw in sip.sonar:
             self._sonar[index] = raw * params.range_conv / 1000.0
             self._sonar_heard[index] = heard
+            self._sonar_fired[index] = stamp
         silent = frozenset(i for i, t in self._sonar_heard.items() if heard - t > self.settings.sonar_timeout)
         v, w = arcos.measured_velocity(sip, params)
-        stamp = self._stamp()
         self._status = BaseStatus(
             pose=Pose2D(x / 1000.0, y / 1000.0, wrap_angle(theta), stamp),
             v=v / 1000.0,
@@ -477,6 +480,7 @@ class PioneerBase:
             motors_enabled=sip.motors_enabled,
             estop=sip.estop,
             sonar=tuple(sorted(self._sonar.items())),
+            sonar_fired=tuple(sorted(self._sonar_fired.items())),
             silent_sonar=silent,
             sips=self._sips + 1,
             stamp=stamp,

@@ -72,17 +72,20 @@ class PioneerBody:
         return tuple(out)
 
     def scan(self, sonar: Mapping[int, float], silent: Collection[int], front_bits: int, rear_bits: int,
-             stamp: float, *, with_sonar: bool = True) -> RangeScan:
+             stamp: float, *, with_sonar: bool = True, fired: Mapping[int, float] | None = None) -> RangeScan:
         """The ring's readings (m, by transducer number; ``silent``: not heard lately) and the SIP's
-        bumper bits (bit ``i``: bumper ``i``) as one scan; without sonar, the bumpers alone."""
+        bumper bits (bit ``i``: bumper ``i``) as one scan; without sonar, the bumpers alone. ``fired``:
+        when each transducer's reading came (the stamp of the SIP that reported it; default ``stamp``)."""
         sensors = self.sensors() if with_sonar else ()
         ranges = np.full(len(sensors), np.nan)
+        when = np.full(len(sensors), stamp)
         for index, metres in sonar.items():
             if index < len(sensors) and index not in silent:
                 ranges[index] = np.inf if metres >= SONAR_MAX_RANGE else metres
+                when[index] = (fired or {}).get(index, stamp)
         pressed = [bool(front_bits >> i & 1) for i in range(self.front_bumpers)]
         pressed += [bool(rear_bits >> i & 1) for i in range(self.rear_bumpers)]
-        return RangeScan(sensors, ranges, stamp, self.bumpers(), np.array(pressed, dtype=bool))
+        return RangeScan(sensors, ranges, stamp, self.bumpers(), np.array(pressed, dtype=bool), fired=when)
 
 
 class PioneerRanges:

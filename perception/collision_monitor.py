@@ -13,7 +13,10 @@ restrictive action of all wins. Here:
 - **approach** (Nav2's approach action): the command is scaled so that, at the new speed, the
   footprint would touch the nearest point on its arc no sooner than ``time_before_collision``
   (eq. 3: ``ratio = t_contact / time_before_collision`` when ``t_contact`` is shorter; straight
-  ahead with a gap ``g`` this is ``v' = g / time_before_collision``);
+  ahead with a gap ``g`` this is ``v' = g / time_before_collision``). A point that closes on the
+  robot by itself at ``u`` m/s (a walker: :mod:`perception.closing`) meets it sooner, and the
+  ratio allows for it: ``ratio = t_contact / time_before_collision - u / |v|`` (eq. 3'; straight
+  ahead ``v' = g / time_before_collision - u``);
 - a **pressed bumper** stops a command that moves towards it (front: ``v > 0``; rear: ``v < 0``);
 - **no data** (no scan, a scan older than ``source_timeout``, every sensor silent): the command is
   limited to a crawl (``crawl_speed``, ``crawl_turn_rate``) and the state says why.
@@ -75,6 +78,7 @@ class MonitorConfig:
     crawl_speed: float = 0.1  # m/s without data
     crawl_turn_rate: float = math.radians(20.0)  # rad/s without data
     memory: float = 1.0  # s: echoes this recent are judged with the scan (the guarded base keeps them); 0: none
+    closing: bool = True  # echoes that close by themselves are judged where they are now (the guarded base)
 
 
 @dataclass(frozen=True, slots=True)
@@ -125,20 +129,24 @@ class CollisionMonitor:
         self.config = config
 
     def check(self, v: float, w: float, scan: RangeScan | None, now: float,
-              remembered: np.ndarray | None = None) -> Verdict:
+              remembered: np.ndarray | None = None, closing: np.ndarray | None = None) -> Verdict:
         """The command ``(v, w)`` limited against ``scan`` at time ``now`` (the scan's clock) and
-        the ``remembered`` echoes of earlier scans (base frame, N x 2), judged alike while the scan is fresh."""
+        the ``remembered`` echoes of earlier scans (base frame, N x 2), judged alike while the scan is
+        fresh; ``closing``: how fast each of the scan's points closes on the robot by itself (m/s,
+        ``RangeScan.points`` order; None: none does)."""
         bumped = scan is not None and bool(np.any(scan.pressed))
         fresh = self._data_problem(scan, now)
         points = scan.points() if fresh is None and scan is not None else np.zeros((0, 2))
+        speeds = np.zeros(len(points)) if closing is None else np.asarray(closing, dtype=float)[:len(points)]
         if fresh is None and remembered is not None and len(remembered):
             points = np.vstack((points, np.asarray(remembered, dtype=float).reshape(-1, 2)))
+        speeds = np.concatenate((speeds, np.zeros(len(points) - len(speeds))))
         gaps = distance(self.config.footprint, points)
         nearest = float(gaps.min()) if len(points) else math.inf
         limits: list[_Limit] = []
         if v != 0.0 or w != 0.0:
             limits += self._bumpers(v, scan)
-            limits += self._crawl(v, w, fresh) if fresh is not None else self._shapes(v, w, points, gaps)
+            limits += self._crawl(v, w, fresh) if fresh is not None else self._shapes(v, w, points, gaps, speeds)
         decisive = min(limits, key=lambda lim: lim.ratio, default=None)
         if decisive is None or decisive.ratio >= 1.0:
             return Verdict(v, w, SafetyState(nearest_m=nearest, bumped=bumped, stamp=now))
@@ -173,18 +181,22 @@ class CollisionMonitor:
         ratio = min(1.0, config.crawl_speed / abs(v) if v else 1.0, config.crawl_turn_rate / abs(w) if w else 1.0)
         return [_Limit(ratio, "crawl", "", f"{problem}: crawling")]
 
-    def _shapes(self, v: float, w: float, points: np.ndarray, gaps: np.ndarray) -> list[_Limit]:
+    def _shapes(self, v: float, w: float, points: np.ndarray, gaps: np.ndarray, closing: np.ndarray) -> list[_Limit]:
         if len(points) == 0:
             return []
         times = contact_times(self.config.footprint, points, v, w)
         horizon = min(SWEEP_LENGTH / abs(v) if v else math.inf, SWEEP_ANGLE / abs(w) if w else math.inf)
         limits = [lim for zone in self.config.zones if (lim := _zone_limit(zone, points, times, gaps, horizon))]
         approach = self.config.time_before_collision
-        soonest = int(np.argmin(times))
-        if approach > 0.0 and times[soonest] < approach:
-            limits.append(_Limit(float(times[soonest]) / approach, "approach", "",  # eq. 3
-                                 f"obstacle {gaps[soonest]:.2f} m away, {times[soonest]:.2f} s ahead on the "
-                                 f"command's arc (keeping {approach:g} s)"))
+        if approach <= 0.0:
+            return limits
+        ratios = times / approach - (closing / abs(v) if v else 0.0)  # eq. 3 (eq. 3' for a closing point)
+        decisive = int(np.argmin(ratios))
+        if ratios[decisive] < 1.0:
+            walking = f", closing at {closing[decisive]:.2f} m/s by itself" if closing[decisive] > 0.0 and v else ""
+            limits.append(_Limit(float(ratios[decisive]), "approach", "",
+                                 f"obstacle {gaps[decisive]:.2f} m away, {times[decisive]:.2f} s ahead on the "
+                                 f"command's arc{walking} (keeping {approach:g} s)"))
         return limits
 
 

@@ -46,6 +46,8 @@ class RangeScan:
     ``ranges[i]`` is sensor ``i``'s range in metres: ``inf`` when it heard no echo within its
     ``max_range``, ``nan`` when it has not read yet (a sonar ring fires in turn). ``pressed[j]`` is
     bumper ``j``. ``extra`` holds obstacle points from other sources (stereo depth), base frame.
+    ``fired[i]`` is when sensor ``i`` took its reading, on the same clock (a ring fires in turn, so
+    a reading can be up to a ring's cycle older than ``stamp``); None: every reading at ``stamp``.
     """
 
     sensors: tuple[RangeSensor, ...]
@@ -54,10 +56,13 @@ class RangeScan:
     bumpers: tuple[Bumper, ...] = ()
     pressed: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     extra: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    fired: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if len(self.ranges) != len(self.sensors):
             raise ValueError(f"{len(self.ranges)} ranges for {len(self.sensors)} sensors")
+        if self.fired is not None and len(self.fired) != len(self.sensors):
+            raise ValueError(f"{len(self.fired)} firing times for {len(self.sensors)} sensors")
         if len(self.pressed) != len(self.bumpers):
             raise ValueError(f"{len(self.pressed)} bumper states for {len(self.bumpers)} bumpers")
 
@@ -85,6 +90,12 @@ class RangeScan:
             off = np.abs(wrap_angles(np.arctan2(dy, dx) - sensor.heading))
             covered |= (off <= sensor.fov / 2.0) & (np.hypot(dx, dy) <= sensor.max_range)
         return covered
+
+    def fired_at(self) -> np.ndarray:
+        """When each sensor took its reading (``stamp`` where the source does not say)."""
+        if self.fired is None:
+            return np.full(len(self.sensors), self.stamp)
+        return np.asarray(self.fired, dtype=float)
 
     def bumped(self, facing: int) -> bool:
         """Is any bumper facing ``facing`` (+1 front, -1 rear) pressed?"""

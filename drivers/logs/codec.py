@@ -235,12 +235,14 @@ def mountings_from(message: Mapping[str, Any], base_frames: Sequence[str] = (BAS
 
 
 def range_messages(scan: RangeScan) -> list[dict[str, Any]]:
-    """One ``sensor_msgs/Range`` per sensor that has read (``nan``: not yet, not written)."""
+    """One ``sensor_msgs/Range`` per sensor that has read (``nan``: not yet, not written), stamped
+    when it read (``RangeScan.fired``)."""
     out = []
+    fired = scan.fired_at()
     for i, (sensor, value) in enumerate(zip(scan.sensors, scan.ranges, strict=True)):
         if math.isnan(float(value)):
             continue
-        out.append({"header": header(scan.stamp, range_frame(i)), "radiation_type": ULTRASOUND,
+        out.append({"header": header(float(fired[i]), range_frame(i)), "radiation_type": ULTRASOUND,
                     "field_of_view": sensor.fov, "min_range": sensor.min_range, "max_range": sensor.max_range,
                     "range": float(value)})
     return out

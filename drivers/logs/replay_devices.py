@@ -139,6 +139,7 @@ class ReplayRanges:
         self._mountings: dict[str, codec.Mounting] = {}
         self._ranges: dict[str, tuple[RangeSensor, float]] = {}
         self._bumpers: dict[str, bool] = {}
+        self._fired: dict[str, float] = {}  # frame -> the header stamp of its newest reading
         self._stamp: float | None = None
         self._scan: RangeScan | None = None
 
@@ -155,6 +156,7 @@ class ReplayRanges:
     def on_range(self, message: LogMessage) -> None:
         frame = self._frame(message)
         self._ranges[frame] = (_sensor(self._mountings[frame], message.message), codec.range_value(message.message))
+        self._fired[frame] = self._replay.stamp_seconds(message)
         self._heard(message)
 
     def on_bumper(self, message: LogMessage) -> None:
@@ -181,8 +183,10 @@ class ReplayRanges:
         if self._scan is None:
             sensors = [sensor for sensor, _ in self._ranges.values()]
             bumpers = [codec.bumper(self._mountings[frame]) for frame in self._bumpers]
+            fired = np.array([self._fired.get(frame, self._stamp) for frame in self._ranges], dtype=float)
             self._scan = RangeScan(tuple(sensors), np.array([value for _, value in self._ranges.values()], float),
-                                   self._stamp, tuple(bumpers), np.array(list(self._bumpers.values()), dtype=bool))
+                                   self._stamp, tuple(bumpers), np.array(list(self._bumpers.values()), dtype=bool),
+                                   fired=fired)
         return self._scan
 
     def describe(self) -> str:

@@ -6,7 +6,10 @@ newest scan of the robot's :class:`~drivers.interfaces.RangeSource`, asks
 :class:`~perception.collision_monitor.CollisionMonitor` for the limited command against it and
 the echoes of the last ``memory`` seconds (kept where the base's odometry put them,
 :class:`~perception.obstacle_memory.ObstacleMemory`), records the
-verdict (:class:`~drivers.safety.log.SafetyLog`) and sends the limited command to the base.
+verdict (:class:`~drivers.safety.log.SafetyLog`) and sends the limited command to the base. Each
+transducer's successive readings say how fast what it hears closes on the robot by itself
+(:class:`~perception.closing.ClosingEchoes`): a walker's echo is judged where it is now, not where
+the transducer last heard it.
 ``stop()`` goes straight through (stopping is always allowed), as do ``odometry()``,
 ``stalled()``, ``close()`` and anything else the wrapped driver offers (``status()``,
 ``report_sections()``...).
@@ -24,6 +27,7 @@ import numpy as np
 
 from drivers.interfaces import Base, RangeSource
 from drivers.safety.log import SafetyLog
+from perception.closing import ClosingEchoes
 from perception.collision_monitor import CollisionMonitor, SafetyState, Verdict
 from perception.geometry import Pose2D
 from perception.obstacle_memory import ObstacleMemory
@@ -42,6 +46,7 @@ class GuardedBase:
         self.state = SafetyState(reason="no command yet")
         self.scan: RangeScan | None = None
         self.memory = ObstacleMemory(keep=monitor.config.memory)
+        self.closing = ClosingEchoes()
         self.log = SafetyLog(sources=_describe(ranges))
 
     def drive(self, v: float, w: float) -> None:
@@ -51,10 +56,18 @@ class GuardedBase:
             verdict = Verdict(v, w, SafetyState(reason="no range sensors", stamp=now))
         else:
             self.scan = self.ranges.read()
-            verdict = self.monitor.check(v, w, self.scan, now, self._remembered(self.scan, now))
+            judged, speeds = self._closing(self.scan, now)
+            verdict = self.monitor.check(v, w, judged, now, self._remembered(self.scan, now), speeds)
         self.state = verdict.state
         self.log.add(v, w, verdict)
         self.base.drive(verdict.v, verdict.w)
+
+    def _closing(self, scan: RangeScan | None, now: float) -> tuple[RangeScan | None, np.ndarray | None]:
+        """``scan`` with its closing echoes where they are now, and each point's closing speed."""
+        if scan is None or not self.monitor.config.closing:
+            return scan, None
+        self.closing = self.closing.added(scan, self.base.odometry())
+        return self.closing.judged(scan, now)
 
     def _remembered(self, scan: RangeScan | None, now: float) -> np.ndarray | None:
         """The echoes of earlier scans (within ``memory`` seconds) in the base frame now; the new

@@ -53,6 +53,9 @@ class SafetySettings(BaseModel):
     memory: float = quantity(1.0, "echoes this recent, in the sonar ring's blind gaps now, are judged with the "
                              "newest scan where odometry put them; 0: the newest scan alone", "s",
                              ge=0.0, le=10.0)
+    closing: bool = Field(True, description="a transducer's successive readings say how fast what it hears closes "
+                          "on the robot by itself (a walker); such an echo is judged where it is now, and the approach "
+                          "action allows for its speed (perception.closing); false: every echo stands still")
 
     @field_validator("footprint", "stop_zone", "slowdown_zone")
     @classmethod
@@ -86,4 +89,5 @@ def monitor_config(settings: SafetySettings | None, footprint: np.ndarray) -> Mo
             raise ValueError(f"safety: the {name}_zone must contain the whole footprint")
         zones.append(Zone(name, polygon, action, ratio))  # type: ignore[arg-type]
     return MonitorConfig(body, tuple(zones), settings.time_before_collision, settings.source_timeout,
-                         settings.crawl_speed, math.radians(settings.crawl_turn_rate), memory=settings.memory)
+                         settings.crawl_speed, math.radians(settings.crawl_turn_rate), memory=settings.memory,
+                         closing=settings.closing)

@@ -15,7 +15,8 @@ the beam, where rays 7.5 degrees apart pass either side of it, or along a wall s
 ``min_range`` reads ``min_range``, and with probability ``miss_probability`` the firing hears
 nothing (``inf``: a specular reflection, a soft surface). Firings are computed when the ring is
 read, at the pose of the read (at most one tick late), with every firing since the last read
-done in its order; noise and misses draw from the run's own seeded stream, so the same seed gives
+done in its order and stamped with the read's time (``RangeScan.fired``: what they measured is the world
+then); noise and misses draw from the run's own seeded stream, so the same seed gives
 the same readings.
 
 Not modelled: specular reflections at grazing angles, cross-talk, the cone's lobes, and a wall end
@@ -70,6 +71,7 @@ class SimRanges:
         self.scene, self.radius, self.rng = scene, radius, rng
         self._state = state
         self._ranges = np.full(len(sensors), np.nan)
+        self._fired = np.full(len(sensors), np.nan)  # when each reading was taken (the read that fired it)
         self._last_slot = -1  # the last firing slot done (slot k fires at k * FIRING_PERIOD_S)
         offsets = np.linspace(-0.5, 0.5, RAYS_PER_CONE)
         self._ray_angles = np.array([s.heading + s.fov * offsets for s in sensors]).reshape(-1, RAYS_PER_CONE)
@@ -94,8 +96,10 @@ class SimRanges:
             due = range(max(self._last_slot + 1, slot - RING_SIZE + 1), slot + 1)
             firing = [k % RING_SIZE + ring for k in due for ring in range(0, len(self.sensors), RING_SIZE)]
             self._fire(np.array(firing, dtype=int), pose)
+            self._fired[firing] = now
         self._last_slot = max(self._last_slot, slot)
-        return RangeScan(self.sensors, self._ranges.copy(), now, self.bumpers, self._pressed(pose))
+        return RangeScan(self.sensors, self._ranges.copy(), now, self.bumpers, self._pressed(pose),
+                         fired=self._fired.copy())
 
     def _fire(self, which: np.ndarray, pose: Pose2D) -> None:
         """Range of each transducer in ``which`` (in that order) from ``pose``, with noise and misses."""

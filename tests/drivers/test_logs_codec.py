@@ -3,6 +3,7 @@ by hand, and every value back as it went in (through the real ROS 2 schemas too)
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 
@@ -158,3 +159,10 @@ def test_transforms_from_another_parent_are_not_mountings():
     transform = {"translation": {"x": 1.0, "y": 0.0}, "rotation": codec.yaw_quaternion(0)}
     message = {"transforms": [{"header": {"frame_id": "map"}, "child_frame_id": "odom", "transform": transform}]}
     assert codec.mountings_from(message) == {}
+
+
+def test_each_range_is_stamped_when_its_sensor_read():
+    fired = dataclasses.replace(SCAN, fired=np.array([3.68, 4.0, math.nan]))  # a ring fires in turn
+    stamps = [m["header"]["stamp"] for m in codec.range_messages(fired)]
+    assert stamps == [{"sec": 3, "nanosec": 680_000_000}, {"sec": 4, "nanosec": 0}]
+    assert [m["header"]["stamp"] for m in codec.range_messages(SCAN)] == [{"sec": 4, "nanosec": 0}] * 2

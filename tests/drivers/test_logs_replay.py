@@ -73,6 +73,7 @@ def test_ranges_and_bumpers_are_rebuilt_from_where_the_sensors_sit(tmp_path):
     later = ranges.read()
     assert later.ranges[0] == pytest.approx(0.9) and later.ranges[1] == math.inf and later.pressed[0]
     assert later.stamp == pytest.approx(0.2)
+    assert later.fired == pytest.approx([later.stamp] * 2)  # each range's own header stamp (codec.range_messages)
 
 
 def test_the_logged_keys_and_the_mission_commands(tmp_path):

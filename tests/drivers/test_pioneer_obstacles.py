@@ -36,6 +36,10 @@ def test_the_sonar_ring_sees_the_wall_with_the_models_geometry(base):
     assert scan.ranges[0] == math.inf and (scan.ranges[8:] == math.inf).all()
     assert scan.points()[:, 0] == pytest.approx(np.full(6, 1.0), abs=0.002)  # every echo lies on the wall
     assert not scan.pressed.any() and len(scan.bumpers) == 10
+    # each reading is stamped with the SIP that brought it: four per SIP in turn, so the ring's readings
+    # come from several SIPs, none later than the newest (perception.closing compares them)
+    assert scan.fired is not None and (scan.fired <= scan.stamp).all() and len(set(scan.fired.tolist())) > 1
+    assert emulator.wait_for(lambda: source.read().fired[1] > scan.fired[1])  # heard again: a new stamp
     emulator.silent_sonar = {3}  # a transducer that stops answering is no data after sonar_timeout
     assert emulator.wait_for(lambda: np.isnan(source.read().ranges[3]), timeout=2.0)
     assert np.isfinite(source.read().ranges[4])

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from drivers.fake import FakeBase
 from drivers.pioneer_body import BODIES
@@ -127,3 +128,23 @@ def test_an_echo_older_than_the_memory_is_forgotten():
     ranges.scan = ring(np.inf, 1.5)
     guard.drive(0.2, -0.8)
     assert base.commands[-1] == (0.2, -0.8)
+
+
+def test_an_echo_closing_by_itself_is_judged_where_it_is_now_and_the_approach_allows_for_it():
+    # the base stands; the transducer 0.2 m ahead of its centre reads 1.5 m, then 1.2 m 0.32 s later:
+    # 0.9375 m/s of closing (perception.closing). At 0.52 s, no new firing: the echo is 0.9375 x 0.2 s
+    # nearer, 1.0125 m from the transducer, 1.0025 m from the P3-DX's front (0.21 m); eq. 3' gives
+    # v' = 1.0025 m / 1 s - 0.9375 m/s = 0.065 m/s. Judged where the ring heard it, 0.3 m/s would pass
+    ahead = (RangeSensor(0.2, 0.0, 0.0),)
+    scans = [RangeScan(ahead, np.array([1.5]), 0.0, fired=np.array([0.0])),
+             RangeScan(ahead, np.array([1.2]), 0.32, fired=np.array([0.32])),
+             RangeScan(ahead, np.array([1.2]), 0.52, fired=np.array([0.32]))]
+    for closing, expected in ((True, 0.065), (False, 0.3)):
+        base, ranges = FakeBase(), Ranges(None)
+        config = monitor_config(SafetySettings(closing=closing), BODIES["p3dx"].footprint)
+        guard = GuardedBase(base, CollisionMonitor(config), ranges, lambda r=ranges: r.scan.stamp)
+        for scan, v in zip(scans, (0.0, 0.0, 0.3), strict=True):
+            ranges.scan = scan
+            guard.drive(v, 0.0)
+        assert base.commands[-1][0] == pytest.approx(expected, abs=1e-3), closing
+        assert ("closing at 0.94 m/s by itself" in guard.state.reason) == closing

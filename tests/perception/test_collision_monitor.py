@@ -147,3 +147,19 @@ def test_remembered_echoes_are_judged_like_the_scans_own_while_the_scan_is_fresh
     assert monitor.check(0.2, 0.0, silent, 0.0).v == 0.2  # the scan alone: nothing
     stale = monitor.check(0.2, 0.0, silent, 5.0, remembered)  # no fresh data: the crawl decides, not old echoes
     assert stale.state.action == "crawl" and stale.v == pytest.approx(0.1)
+
+
+def test_approach_allows_for_a_point_closing_by_itself():
+    approach_only = MonitorConfig(FOOTPRINT, (), time_before_collision=1.0)
+    # a point 0.81 m ahead of the centre is 0.60 m ahead of the front: standing still, at 0.3 m/s
+    # contact is 2 s away, and the command passes; walking at the robot at 0.5 m/s it is 0.75 s
+    # away, and eq. 3' gives v' = 0.60 m / 1 s - 0.5 m/s = 0.10 m/s (ratio 1/3)
+    scan = scan_of((0.81, 0.0))
+    assert CollisionMonitor(approach_only).check(0.3, 0.0, scan, 0.0, closing=np.array([0.0])).v == 0.3
+    verdict = CollisionMonitor(approach_only).check(0.3, 0.0, scan, 0.0, closing=np.array([0.5]))
+    assert verdict.v == pytest.approx(0.10)
+    assert verdict.state.action == "approach" and "closing at 0.50 m/s by itself" in verdict.state.reason
+    # closing at 0.7 m/s, faster than the gap over the time kept: stopped
+    assert CollisionMonitor(approach_only).check(0.3, 0.0, scan, 0.0, closing=np.array([0.7])).v == 0.0
+    # turning on the spot towards it is the turn's own business (no speed to scale by u / |v|)
+    assert CollisionMonitor(approach_only).check(0.0, 0.5, scan, 0.0, closing=np.array([0.7])).w == 0.5
