@@ -107,8 +107,8 @@ def _closing(last: ClosingEchoes, fired: np.ndarray, ranges: np.ndarray, origins
     interval = fired - last.fired
     offsets = np.linspace(-0.5, 0.5, ARC_SAMPLES)[None, :] * fov[:, None]  # (N, K) across the cone
     bearing = last.headings[:, None] + offsets
-    arc = last.origins[:, None, :] + last.ranges[:, None, None] * np.stack((np.cos(bearing), np.sin(bearing)), -1)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore"):  # no echo (inf) or none yet (nan): not judged, below
+        arc = last.origins[:, None, :] + last.ranges[:, None, None] * np.stack((np.cos(bearing), np.sin(bearing)), -1)
         seen = arc - origins[:, None, :]
         distance = np.hypot(seen[..., 0], seen[..., 1])
         inside = np.abs(wrap_angles(np.arctan2(seen[..., 1], seen[..., 0]) - headings[:, None])) <= fov[:, None] / 2
