@@ -179,7 +179,7 @@ def check_options(world: str, extra: Mapping[str, str]) -> Settings:
                                      usable_poses(loaded, room))
     fewer = source == PLACED and extra.get("targets") is None  # the default count: as many as fit
     if source == PLACED:
-        targets = placeable(loaded, targets, away_from_exits(room, grid), fewer=fewer)
+        targets, _ = placeable(loaded, targets, away_from_exits(room, grid), fewer=fewer)
     starts = parse_starts(extra.get("starts"))
     if starts:
         random_starts(loaded, 1, 0, grid=room)  # ValueError: nowhere clear enough to start from
@@ -208,17 +208,16 @@ def choose_targets(text: str | None, world: World, usable: Mapping[str, Pose2D],
 
 
 def placeable(world: World, names: tuple[str, ...], room: FloorGrid, *, fewer: bool,
-              seeds: Sequence[int] = (0,)) -> tuple[str, ...]:
+              seeds: Sequence[int] = (0,)) -> tuple[tuple[str, ...], dict[int, dict[str, Pose2D]]]:
     """``names`` when every one of ``seeds`` places them all in the learning's room; with ``fewer``
     (the default count, not one the user gave) as many as they all place, down to ``MIN_TARGETS``
     (`clinic`'s room holds 3, `flat`'s 3 for seed 0 and 2 for seed 1); else ``ValueError`` with
-    the problem."""
+    the problem. With the names, each seed's placed poses (placing takes a second or more: done once)."""
     count = len(names)
     while True:
         try:
-            for seed in seeds:
-                place_targets(world, count, seed, grid=room)
-            return placed_names(count)
+            placed = {seed: place_targets(world, count, seed, grid=room) for seed in seeds}
+            return placed_names(count), placed
         except ValueError:
             if not fewer or count <= MIN_TARGETS:
                 raise
@@ -262,15 +261,16 @@ def seed_folder(folder: Path, world: str, seed: int) -> Path:
 
 
 def seed_targets(world: str, loaded: World, settings: Settings, seed: int, folder: Path,
-                 grid: FloorGrid | None = None) -> SeedTargets:
-    """The seed's targets. Named poses: the world as it is. Placed: ``place_targets`` from the seed,
-    written as named poses into a copy of the world file in the seed's folder (same file name, so
-    the world keeps its name and the episodes' ids their world part); ``SweepInputError`` when the
-    world has no room for them with this seed."""
+                 grid: FloorGrid | None = None, *, placed: Mapping[str, Pose2D] | None = None) -> SeedTargets:
+    """The seed's targets. Named poses: the world as it is. Placed: ``placed`` when :func:`placeable`
+    placed them already, else ``place_targets`` from the seed, written as named poses into a copy of
+    the world file in the seed's folder (same file name, so the world keeps its name and the
+    episodes' ids their world part); ``SweepInputError`` when the world has no room for them with
+    this seed."""
     if settings.source == NAMED:
         return SeedTargets(world, {name: loaded.poses[name] for name in settings.targets})
     try:
-        poses = place_targets(loaded, len(settings.targets), seed, grid=grid)
+        poses = dict(placed) if placed is not None else place_targets(loaded, len(settings.targets), seed, grid=grid)
     except ValueError as exc:
         raise SweepInputError(f"seed {seed}: {exc}") from None
     here = seed_folder(folder, world, seed)
@@ -486,13 +486,15 @@ def run(options: EvalOptions, *, resume: bool = False) -> dict[str, Any]:
     moved = _moved_start(loaded, grid)
     room = learning_room(loaded, grid, moved or loaded.start)  # once: every seed's starts
     inner = away_from_exits(room, grid) if settings.source == PLACED else room
+    placed: dict[int, dict[str, Pose2D]] = {}
     if settings.fewer:  # as many as every seed places (check_options tried seed 0)
         try:
-            settings = replace(settings, targets=placeable(loaded, settings.targets, inner, fewer=True,
-                                                           seeds=options.seeds))
+            names, placed = placeable(loaded, settings.targets, inner, fewer=True, seeds=options.seeds)
         except ValueError as exc:
             raise SweepInputError(str(exc)) from None
-    targets = {seed: seed_targets(world, loaded, settings, seed, folder, inner) for seed in options.seeds}
+        settings = replace(settings, targets=names)
+    targets = {seed: seed_targets(world, loaded, settings, seed, folder, inner, placed=placed.get(seed))
+               for seed in options.seeds}
     truth = {seed: t.poses for seed, t in targets.items()}
     navigate_in, people = navigation_worlds(loaded, settings, targets, folder, room)
     hidden = {seed: out_of_sight(loaded, moved or loaded.start, t.poses) for seed, t in targets.items()}

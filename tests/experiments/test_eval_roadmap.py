@@ -450,8 +450,10 @@ def test_the_default_count_of_placed_targets_is_what_every_seed_places():
     grid = reachable_grid(flat)
     start = learn_start(flat, grid)
     inner = away_from_exits(learning_room(flat, grid, start), grid)
-    assert placeable(flat, placed_names(4), inner, fewer=True) == placed_names(3)
-    assert placeable(flat, placed_names(3), inner, fewer=True, seeds=[0, 1]) == placed_names(2)
+    assert placeable(flat, placed_names(4), inner, fewer=True)[0] == placed_names(3)
+    names, placed = placeable(flat, placed_names(3), inner, fewer=True, seeds=[0, 1])
+    assert names == placed_names(2) and sorted(placed) == [0, 1]
+    assert placed[1] == place_targets(flat, 2, 1, grid=inner)  # the poses each seed's episodes use
     with pytest.raises(ValueError, match="has room for 2 target\\(s\\), not 3"):
         placeable(flat, placed_names(3), inner, fewer=False, seeds=[0, 1])
     settings = check_options("flat", {})
