@@ -156,8 +156,7 @@ class ReplayRanges:
     def on_range(self, message: LogMessage) -> None:
         frame = self._frame(message)
         self._ranges[frame] = (_sensor(self._mountings[frame], message.message), codec.range_value(message.message))
-        self._fired[frame] = self._replay.stamp_seconds(message)
-        self._heard(message)
+        self._fired[frame] = self._heard(message)
 
     def on_bumper(self, message: LogMessage) -> None:
         frame = self._frame(message)
@@ -171,10 +170,12 @@ class ReplayRanges:
                              "(where does the sensor sit?)")
         return frame
 
-    def _heard(self, message: LogMessage) -> None:
+    def _heard(self, message: LogMessage) -> float:
+        """The message's stamp (seconds on the replay's clock), now the newest reading's if later."""
         stamp = self._replay.stamp_seconds(message)
         self._stamp = stamp if self._stamp is None else max(self._stamp, stamp)
         self._scan = None
+        return stamp
 
     def read(self) -> RangeScan | None:
         """Every sensor's newest range and every bumper's newest state (None before the first)."""

@@ -56,26 +56,33 @@ class GuardedBase:
             verdict = Verdict(v, w, SafetyState(reason="no range sensors", stamp=now))
         else:
             self.scan = self.ranges.read()
-            judged, speeds = self._closing(self.scan, now)
-            verdict = self.monitor.check(v, w, judged, now, self._remembered(self.scan, now), speeds)
+            pose = self._pose(self.scan)  # one odometry read for both: they judge the same scan
+            judged, speeds = self._closing(self.scan, pose, now)
+            verdict = self.monitor.check(v, w, judged, now, self._remembered(self.scan, pose, now), speeds)
         self.state = verdict.state
         self.log.add(v, w, verdict)
         self.base.drive(verdict.v, verdict.w)
 
-    def _closing(self, scan: RangeScan | None, now: float) -> tuple[RangeScan | None, np.ndarray | None]:
+    def _pose(self, scan: RangeScan | None) -> Pose2D | None:
+        """The base's odometry, when the closing speeds or the memory need it for ``scan``."""
+        if scan is None or not (self.monitor.config.closing or self.memory.keep > 0.0):
+            return None
+        return self.base.odometry()
+
+    def _closing(self, scan: RangeScan | None, pose: Pose2D | None,
+                 now: float) -> tuple[RangeScan | None, np.ndarray | None]:
         """``scan`` with its closing echoes where they are now, and each point's closing speed."""
-        if scan is None or not self.monitor.config.closing:
+        if scan is None or pose is None or not self.monitor.config.closing:
             return scan, None
-        self.closing = self.closing.added(scan, self.base.odometry())
+        self.closing = self.closing.added(scan, pose)
         return self.closing.judged(scan, now)
 
-    def _remembered(self, scan: RangeScan | None, now: float) -> np.ndarray | None:
+    def _remembered(self, scan: RangeScan | None, pose: Pose2D | None, now: float) -> np.ndarray | None:
         """The echoes of earlier scans (within ``memory`` seconds) in the base frame now; the new
         scan joins them for the next command. Only those in the ring's blind gaps count: where a
         transducer looks now, its own reading says what is there (``RangeScan.covers``)."""
-        if scan is None or self.memory.keep <= 0.0:
+        if scan is None or pose is None or self.memory.keep <= 0.0:
             return None
-        pose = self.base.odometry()
         earlier = self.memory.around(pose, now)
         self.memory = self.memory.added(scan.points(), pose, scan.stamp)
         return earlier[~scan.covers(earlier)]
