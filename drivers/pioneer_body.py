@@ -78,11 +78,11 @@ class PioneerBody:
         when each transducer's reading came (the stamp of the SIP that reported it; default ``stamp``)."""
         sensors = self.sensors() if with_sonar else ()
         ranges = np.full(len(sensors), np.nan)
-        when = np.full(len(sensors), stamp)
+        when, fired = np.full(len(sensors), stamp), fired or {}
         for index, metres in sonar.items():
             if index < len(sensors) and index not in silent:
                 ranges[index] = np.inf if metres >= SONAR_MAX_RANGE else metres
-                when[index] = (fired or {}).get(index, stamp)
+                when[index] = fired.get(index, stamp)
         pressed = [bool(front_bits >> i & 1) for i in range(self.front_bumpers)]
         pressed += [bool(rear_bits >> i & 1) for i in range(self.rear_bumpers)]
         return RangeScan(sensors, ranges, stamp, self.bumpers(), np.array(pressed, dtype=bool), fired=when)

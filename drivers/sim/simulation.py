@@ -205,7 +205,8 @@ class Simulation:
             if not self._in_contact:  # a new contact episode (not the same push, step after step)
                 self.collisions += 1
                 self.collisions_with_people += int(by_person)
-                self._contacts.append(self._where(self.time + dt, "person" if by_person else "surface"))
+                if len(self._contacts) < REPORTED_CONTACTS:  # the rest are counted, not placed
+                    self._contacts.append(self._where(self.time + dt, "person" if by_person else "surface"))
             self.stalled = self._in_contact = True
         else:
             self.stalled = False
@@ -339,7 +340,7 @@ class Simulation:
             "collisions_with_people": int(self.collisions_with_people),
             "min_clearance_m": float(self.min_clearance) if math.isfinite(self.min_clearance) else None,
             "min_clearance_at": self._nearest_at,
-            "collisions_at": self._contacts[:REPORTED_CONTACTS],
+            "collisions_at": list(self._contacts),
             "stalled_time_s": float(self._stalled_time),
             "trajectory": _decimate(true, max_points=2000),
             "stops": _stops(true),
