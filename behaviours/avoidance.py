@@ -13,7 +13,11 @@ child wrote (``child_command``: ``/robot/command`` unless remapped) against the 
   one side of the obstacle, kept within ``max_stray`` of the line the robot was on (odometry),
   until the child's own arc is free again; the child then steers back to its route or path by
   itself;
-- no direction will do: backing away ``backoff`` metres along the way the robot came
+- no direction will do: with ``plan``, a way round planned on the echoes of the last
+  ``echo_memory`` seconds (:mod:`maps.avoidance.wayround`: back out of a pocket and round what
+  holds the robot, to a metre past where it was held) and driven, the directions judged as before
+  along it;
+- no direction and no way round: backing away ``backoff`` metres along the way the robot came
   (:mod:`maps.avoidance.backoff`), then judging again from there;
 - with ``undo``, a detour held until its ``timeout`` is driven back along its own way, once, and
   the other side tried for ``wait`` seconds more (a detour into a gap too narrow to pass);
@@ -33,8 +37,10 @@ passes every command on; the collision monitor still limits whatever reaches the
 
 Report section ``avoidance``, per node (its name): ``waits``, ``waits_cleared`` (the way cleared by
 itself), ``wait_time_s``, ``detours``, ``detour_length_m``, ``detour_time_s``, ``backoffs``,
-``backoff_m``, ``give_ups`` and their ``reasons``. Recording: ``avoidance/events``,
-``avoidance/phase`` (0 clear, 1 waiting, 2 detour, 3 backing away), the histogram of directions
+``backoff_m``, ``ways`` (ways round planned) and ``way_m`` (driven along them), ``give_ups`` and
+their ``reasons``. Recording: ``avoidance/events``,
+``avoidance/phase`` (0 clear, 1 waiting, 2 detour, 3 backing away), the way round being driven
+(``odometry_frame/avoidance/way``), the histogram of directions
 judged (``avoidance/robot_frame/histogram``: a ray per direction as far as it is free up to 1 m,
 the chosen one green, those that would do grey, the others red) with the chosen direction
 (``avoidance/robot_frame/chosen``), and the detours driven (``odometry_frame/avoidance/detours``).
@@ -59,10 +65,13 @@ from behaviours.registry import register
 from behaviours.telemetry import Arrows, Drawing, Event, Figure, Lines, Plot
 from drivers.interfaces import STOP, VelocityCommand
 from maps.avoidance.backoff import BackoffSettings
-from maps.avoidance.detour import Avoidance, Decision, DetourSettings, Phase
+from maps.avoidance.detour import Avoidance
 from maps.avoidance.directions import Choice
+from maps.avoidance.state import Decision, DetourSettings, Phase
 from maps.avoidance.sweep import AvoidSettings
+from maps.avoidance.wayround import WayRound
 from perception.collision_monitor import SafetyState
+from perception.echo_map import EchoMap
 from perception.geometry import Pose2D
 from perception.obstacle_memory import ObstacleMemory
 from perception.polygons import disc
@@ -71,6 +80,7 @@ from perception.ranges import RangeScan
 PHASES: dict[Phase, float] = {"clear": 0.0, "waiting": 1.0, "detour": 2.0, "backoff": 3.0}
 DRAWN_REACH = 1.0  # m: arcs are drawn as far as they are free, up to this
 CHOSEN, FREE, BLOCKED = (0, 220, 0), (170, 170, 170), (230, 60, 40)
+WAY = (60, 140, 255)
 REASONS_KEPT = 5  # give-up reasons in the report
 
 
@@ -106,6 +116,11 @@ class AvoidObstacles(BearingsDecorator):
     GOING_ROUND = InputPort("going_round", bool, True, literal_only=True,
                             doc="give up a detour that has turned 180 deg (it goes round what the child heads for); "
                                 "false for a child whose own path turns (a search pattern)")
+    PLAN = InputPort("plan", bool, True, literal_only=True,
+                     doc="no direction will do: plan a way round on the echoes of the last 'echo_memory' seconds")
+    ECHO_MEMORY = InputPort("echo_memory", float, 20.0, unit="s", minimum=1.0, maximum=600.0, literal_only=True,
+                            doc="echoes are kept this long for planning a way round, or until a newer reading "
+                                "sees through them")
     MEMORY = InputPort("memory", float, 1.0, unit="s", minimum=0.0, maximum=10.0, literal_only=True,
                        doc="range echoes are remembered this long (odometry frame)")
     ROBOT_RADIUS = InputPort("robot_radius", float, 0.0, unit="m", minimum=0.0, maximum=2.0, literal_only=True,
@@ -118,18 +133,21 @@ class AvoidObstacles(BearingsDecorator):
                       doc="true while it holds the robot for the way to clear by itself (the first 'wait' seconds)")
     RANGES_OPTIONAL = True  # without ranges it passes every command on: a log without them replays (missions.log_check)
     PORTS = (ENABLED, SPEED, TURN_RATE, CLEARANCE, HORIZON, WAIT, TIMEOUT, MAX_STRAY, MAX_DETOUR, BACKOFF, PASS_TURNS,
-             UNDO, GOING_ROUND, MEMORY, ROBOT_RADIUS, FOOTPRINT, CHILD_COMMAND, RANGES, ODOMETRY, SAFETY, COMMAND, HELD)
+             UNDO, GOING_ROUND, PLAN, ECHO_MEMORY, MEMORY, ROBOT_RADIUS, FOOTPRINT, CHILD_COMMAND, RANGES, ODOMETRY,
+             SAFETY, COMMAND, HELD)
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour, **ports: Any) -> None:
         super().__init__(name=name, child=child, **ports)
         self.avoidance = self._avoidance(DEFAULT_FOOTPRINT)  # until the robot's own is known (first tick)
         self._footprint_known = False
         self.memory = ObstacleMemory(self.get_input(self.MEMORY))
+        self.echoes = EchoMap(self.get_input(self.ECHO_MEMORY))
         self.decision: Decision | None = None
         self._events: list[str] = []
         self._trail: list[list[float]] = []  # the current detour's odometry positions
         self._detours: list[np.ndarray] = []  # every detour driven, for the recording
         self._drawn = (0, False)  # (detours drawn, arcs drawn)
+        self._way: WayRound | None = None  # the way round drawn
 
     def update(self) -> Status:
         child = self.decorated.status
@@ -146,12 +164,15 @@ class AvoidObstacles(BearingsDecorator):
             self.avoidance = self._avoidance(footprint_of(self))
         now = self.now()
         scan = self.get_input(self.RANGES, None)
+        planning = self.get_input(self.PLAN)
         if scan is not None:
             self.memory = self.memory.added(scan.points(), pose, scan.stamp)
+            if planning:
+                self.echoes = self.echoes.added(scan, pose)
         safety = self.get_input(self.SAFETY, None)
         stopped = safety is not None and safety.state == "stopped"
         decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped,
-                                       reach=wish.reach)
+                                       reach=wish.reach, echoes=self.echoes.around(pose) if planning else None)
         self._record(decision, pose)
         # waiting, no way round judged yet (the fan is judged once the wait is over): the wait itself
         self.set_output(self.HELD, decision.phase == "waiting" and decision.choice is None)
@@ -179,7 +200,8 @@ class AvoidObstacles(BearingsDecorator):
         return Avoidance(settings, DetourSettings(
             wait=self.get_input(self.WAIT), timeout=self.get_input(self.TIMEOUT),
             max_length=self.get_input(self.MAX_DETOUR), pass_turns=self.get_input(self.PASS_TURNS),
-            going_round=self.get_input(self.GOING_ROUND), undo=self.get_input(self.UNDO)),
+            going_round=self.get_input(self.GOING_ROUND), undo=self.get_input(self.UNDO),
+            plan=self.get_input(self.PLAN)),
             BackoffSettings(distance=self.get_input(self.BACKOFF)))
 
     def terminate(self, new_status: Status) -> None:
@@ -210,7 +232,8 @@ class AvoidObstacles(BearingsDecorator):
             "waits": tally.waits, "waits_cleared": tally.waits_cleared, "wait_time_s": round(tally.wait_time, 2),
             "detours": tally.detours, "detour_length_m": round(tally.detour_length, 3),
             "detour_time_s": round(tally.detour_time, 2), "backoffs": tally.backoffs,
-            "backoff_m": round(tally.backoff_length, 3), "creeps": tally.creeps, "give_ups": tally.give_ups,
+            "backoff_m": round(tally.backoff_length, 3), "creeps": tally.creeps, "ways": tally.ways,
+            "way_m": round(tally.way_length, 3), "give_ups": tally.give_ups,
             "reasons": tally.reasons[-REASONS_KEPT:]}
         for name, value in values.items():
             yield Figure("avoidance", f"{key}.{name}", value)
@@ -232,6 +255,10 @@ class AvoidObstacles(BearingsDecorator):
             yield Lines("avoidance/robot_frame/histogram", [], FREE)
             yield Arrows("avoidance/robot_frame/chosen", np.zeros((0, 2)), CHOSEN)
             arcs_drawn = False
+        way = self.avoidance.way
+        if way is not self._way:  # a way round planned, planned again or over
+            yield Lines("odometry_frame/avoidance/way", [] if way is None else [way.path], WAY, radius=0.015)
+            self._way = way
         if len(self._detours) != detours:
             yield Lines("odometry_frame/avoidance/detours", list(self._detours), (255, 140, 0), radius=0.02)
             detours = len(self._detours)

@@ -8,9 +8,13 @@ module          what it holds
 ``directions``  the free direction closest to the wish (a polar histogram, VFH+) and the
                 command that takes it (an arc, or a turn on the spot first)
 ``backoff``     backing away along the robot's own trail when no direction will do
+``wayround``    a way round planned on the echoes of tens of seconds, where no direction
+                will do (a grid, its distance transform, Dijkstra)
+``state``       the values a tick reads and writes: settings, decision, tallies, the
+                episode (a wait and the detour it may turn into)
 ``detour``      one tick's decision: pass the wish on, wait for the way to clear, detour,
-                back away, or give up; the tallies the report gets (detours, length,
-                time, waits, back-offs)
+                drive a way round, back away, or give up; the tallies the report gets
+                (detours, length, time, waits, ways, back-offs)
 ==============  =========================================================================
 
 Everything is in the base frame (REP-103: x forward, y left) unless a name says odometry. The

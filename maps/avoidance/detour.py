@@ -48,6 +48,13 @@ the robot's odometry. Three phases:
   and scans) fails when its turn does not happen; such a turn during a detour is the node's, not
   the detour's, and does not count towards :data:`GOING_ROUND`.
 
+A way round (``plan``): when, :data:`SETTLE` after the wait or ``wait`` seconds into a detour's
+hold, no direction within :data:`FACING` will do for the obstacles around (not merely for
+straying), a path is planned on the echoes kept longer (``step``'s ``echoes``) before anything
+backs away, and driven as a detour (:mod:`maps.avoidance.wayround`); held, it is planned again
+(every :data:`REPLAN` s at most); none left, or driven, the detour goes on as without it. The
+turns on a way are not the detour's (:data:`GOING_ROUND`), and its length counts from the way's start.
+
 Backing away (``backoff``): when, after the wait or ``wait`` seconds into a detour's hold, no
 direction will do for the obstacles around (not merely for straying), the robot backs along its
 own trail (:mod:`maps.avoidance.backoff`) up to ``distance`` metres, then judges again from there;
@@ -91,18 +98,18 @@ the run report's ``avoidance`` section shows.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
-from typing import Literal
+from dataclasses import replace
 
 import numpy as np
 
 from maps.avoidance.backoff import MIN_BACK, STEP, BackoffSettings, Trail, back_command
 from maps.avoidance.directions import Choice, choose, steer, wished_direction
+from maps.avoidance.state import Decision, DetourSettings, Episode, HoldEnded, Phase, Tally
 from maps.avoidance.sweep import AvoidSettings, DetourLine, Surroundings, free_distance, needed_distance
+from maps.avoidance.wayround import WayRound, along, plan
 from perception.geometry import Pose2D, wrap_angle
 from perception.polygons import distance, enclosing_radius
 
-Phase = Literal["clear", "waiting", "detour", "backoff"]
 GOING_ROUND = math.pi  # rad: a detour that has turned this much is going round the obstacle, not past it
 BACKOFFS_PER_HOLD = 2  # back-offs in one hold (the hold goes on where the robot backed away from)
 RESTART_GAP = 2.0  # s: a hold cut short by the node's ending goes on when held again this soon ...
@@ -110,93 +117,10 @@ STOOD = 0.05  # m: ... this close to where it was held
 PROGRESS = 0.1  # m: a detour that has not moved this far from where it was for ``timeout`` s got nowhere
 CREEP = 0.1  # m/s: a wish held only by the margin beside its way goes on this slowly, where that is open
 FACING = math.pi / 2.0  # rad: a detour takes no direction farther than this from the wish
+REPLAN = 1.0  # s: a way round held is planned again at most this often
+SETTLE = 1.0  # s beyond the wait before a way round is planned: a walker gone is in the last second's echoes
+WAY_LENGTH = 2.0  # a way round may be this many times a detour's ``max_length`` (it goes back round what holds it)
 
-
-@dataclass(frozen=True, slots=True)
-class DetourSettings:
-    """How long to wait, when to give up (module docstring)."""
-
-    wait: float = 2.0  # s held before a detour is tried
-    timeout: float = 20.0  # s held (waiting, or on a detour with no direction) before giving up
-    clear_time: float = 1.0  # s the way must stay clear to end a wait or a detour
-    max_length: float = 6.0  # m: a detour this long that has not got past gives up
-    pass_turns: bool = False  # a wish to turn on the spot passes in every phase (nodes that turn by a measured angle)
-    going_round: bool = True  # a detour turned by GOING_ROUND gives up (off for nodes whose own path turns)
-    undo: bool = False  # a detour held to its timeout: back along its own way, then the other side (module doc)
-
-
-@dataclass(frozen=True, slots=True)
-class Decision:
-    """What the base gets this tick, the phase after the tick and why."""
-
-    v: float
-    w: float
-    phase: Phase
-    choice: Choice | None = None  # the fan, when it was judged this tick
-    event: str = ""  # a line for the recording's event log ("" when nothing changed)
-    gave_up: str = ""  # the reason, when the avoidance gives up this tick
-    passed: bool = False  # the wish went on unchanged
-
-
-@dataclass
-class Tally:
-    """What the avoidance did over a run (the report's figures)."""
-
-    waits: int = 0  # times the robot was held for a blocked way
-    waits_cleared: int = 0  # ... of which the way cleared by itself (no detour)
-    wait_time: float = 0.0  # s held before the way cleared or a detour started
-    detours: int = 0
-    detour_length: float = 0.0  # m driven on detours (odometry)
-    detour_time: float = 0.0  # s
-    give_ups: int = 0
-    backoffs: int = 0  # times the robot backed away along its trail, no direction doing
-    backoff_length: float = 0.0  # m backed (odometry)
-    creeps: int = 0  # times a wish held only by what lies beside its way went on at the creep speed
-    reasons: list[str] = field(default_factory=list)  # why, per give-up
-
-
-@dataclass(frozen=True, slots=True)
-class _HoldEnded:
-    """A hold that stopped without ending (cut short by the node's ending, or left by a back-off):
-    since when it held, when it stopped, where, and its back-offs. A new hold soon after, near there,
-    is the same hold going on (:meth:`goes_on`)."""
-
-    origin: float
-    when: float
-    where: Pose2D
-    backoffs: int = 0
-
-    def goes_on(self, pose: Pose2D, now: float, *, within: float, near: float) -> bool:
-        """Is a hold at ``pose`` now this one going on: within ``within`` s of when it stopped and
-        ``near`` m of where?"""
-        return now - self.when <= within and math.hypot(pose.x - self.where.x, pose.y - self.where.y) <= near
-
-
-@dataclass
-class _Episode:
-    """A wait, and the detour it may turn into."""
-
-    since: float  # when the robot was first held
-    line: DetourLine
-    origin: float  # when the hold began, for the wait and the timeout: since, or a cut hold's (_held_since)
-    detour_start: float | None = None
-    length: float = 0.0
-    turned: float = 0.0  # rad, signed: the heading's change since the detour started
-    last: Pose2D | None = None
-    side: int = 0
-    goal: float | None = None  # rad, odometry: where the wish heads, from its last forward command
-    clear_since: float | None = None  # the way clear since (the wish passing again)
-    held_since: float | None = None  # on a detour with no direction (or stopped by the monitor) since
-    by_monitor: bool = False  # held because the collision monitor stopped a wish the arcs found free
-    child_turning: bool = False  # the last tick passed the node's own turn on the spot (pass_turns)
-    backoffs: int = 0  # back-offs in this hold; after one the wait lasts until a detour starts
-    backing: tuple[float, float] | None = None  # the trail point backed to (odometry), while backing
-    backed: float = 0.0  # m backed in the current back-off
-    back_limit: float = 0.0  # m the current back-off was asked for (it backs at most twice that)
-    beyond: float = 0.0  # m a direction must be free for after a back-off: past where the robot was wedged
-    undoing: bool = False  # the back-off going on undoes the detour (``undo``): the other side after it
-    undone: bool = False  # the detour was undone once (an episode undoes once)
-    anchor: tuple[float, Pose2D] | None = None  # (since, where): the detour has not moved PROGRESS from there since
 
 
 class Avoidance:
@@ -208,25 +132,34 @@ class Avoidance:
         self.settings = settings or DetourSettings()
         self.backoff = backoff or BackoffSettings()
         self.trail = Trail(keep=self.backoff.keep)
-        self._backed_from: _HoldEnded | None = None  # the last back-off: its hold, when it ended, where it began
+        self._backed_from: HoldEnded | None = None  # the last back-off: its hold, when it ended, where it began
         self.tally = Tally()
         self.phase: Phase = "clear"
-        self._episode: _Episode | None = None
+        self._episode: Episode | None = None
         self._pose: Pose2D | None = None  # the last tick's
-        self._cut: _HoldEnded | None = None  # a hold that reset cut short
+        self._cut: HoldEnded | None = None  # a hold that reset cut short
         self._failed: tuple[Pose2D, float, int] | None = None  # the last detour given up: (where, when, its side)
         self._creeping = False  # the last tick went on at the creep speed
+        self._echoes: np.ndarray | None = None  # this tick's echoes kept longer, with its points (base frame)
 
     @property
     def line(self) -> DetourLine | None:
         """The line the current wait or detour started on (None while clear)."""
         return self._episode.line if self._episode is not None else None
 
+    @property
+    def way(self) -> WayRound | None:
+        """The way round being driven (None: none)."""
+        return self._episode.way if self._episode is not None else None
+
     def step(self, v: float, w: float, points: np.ndarray, pose: Pose2D, now: float, *,
-             stopped: bool = False, reach: float = math.inf) -> Decision:
+             stopped: bool = False, reach: float = math.inf, echoes: np.ndarray | None = None) -> Decision:
         """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
         robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command;
-        ``reach``: how far the wish means to go before the node's goal (m; ``inf``: no goal in sight)."""
+        ``reach``: how far the wish means to go before the node's goal (m; ``inf``: no goal in sight);
+        ``echoes``: the echoes kept longer (base frame, :mod:`perception.echo_map`), which a way round
+        is planned on (``plan``; None: none is)."""
+        self._echoes = None if echoes is None else np.vstack((points, echoes))
         creeping, self._creeping = self._creeping, False
         episode = self._episode
         if episode is not None and episode.backing is not None:
@@ -265,7 +198,7 @@ class Avoidance:
         episode = self._episode
         held = None if episode is None else episode.held_since if episode.detour_start is not None else \
             None if self.phase == "clear" else episode.origin
-        self._cut = None if held is None or self._pose is None else _HoldEnded(held, now, self._pose)
+        self._cut = None if held is None or self._pose is None else HoldEnded(held, now, self._pose)
         if episode is not None:
             if episode.detour_start is not None:
                 self._end_detour(episode, now)
@@ -285,7 +218,7 @@ class Avoidance:
         episode = self._episode
         resumed = episode is not None and episode.clear_since is not None
         if episode is None or not resumed:
-            episode = self._episode = _Episode(now, DetourLine.at(pose), self._held_since(pose, now))
+            episode = self._episode = Episode(now, DetourLine.at(pose), self._held_since(pose, now))
             self._near_backoff(episode, pose, now)
             self.tally.waits += 1
         episode.clear_since = None
@@ -294,7 +227,7 @@ class Avoidance:
         ahead = "(the collision monitor stopped it)" if by_monitor else self._ahead(v, w, around.points)
         return Decision(0.0, 0.0, "waiting", event="" if resumed else f"the way is blocked {ahead}: waiting")
 
-    def _wait(self, episode: _Episode, v: float, w: float, around: Surroundings, pose: Pose2D, now: float
+    def _wait(self, episode: Episode, v: float, w: float, around: Surroundings, pose: Pose2D, now: float
               ) -> Decision:
         held = now - episode.origin
         if held < self.settings.wait:
@@ -302,13 +235,13 @@ class Avoidance:
         choice = choose(around, self._wish(episode, v, w, pose), self.avoid, reach=self._reach(v, episode), pose=pose,
                         line=episode.line, side=self._other_side(pose, now), within=FACING)
         if choice.direction is not None:
-            self._end_wait(episode, now, cleared=False)
-            episode.detour_start, episode.last, episode.side = now, pose, choice.side
-            self.phase = "detour"
-            self.tally.detours += 1
+            self._start_detour(episode, pose, now, choice.side)
             side = {1: "left", -1: "right"}.get(choice.side, "ahead")
             return Decision(*steer(choice, around, self.avoid), "detour", choice,
                             f"detour to the {side} after {held:.1f} s")
+        if self._planned(episode, held, choice, (v, w), pose, now):
+            self._start_detour(episode, pose, now, 0)
+            return self._way_begun(episode, (v, w), around, pose, now, f"no direction will do after {held:.1f} s")
         backing = self._start_back(episode, choice, around, pose, now)
         if backing is not None:
             return backing
@@ -316,7 +249,7 @@ class Avoidance:
             return self._give_up(self._blocked_reason(held, v, w, around.points, choice), now)
         return Decision(0.0, 0.0, "waiting", choice)
 
-    def _detour(self, episode: _Episode, v: float, w: float, around: Surroundings, pose: Pose2D, now: float,
+    def _detour(self, episode: Episode, v: float, w: float, around: Surroundings, pose: Pose2D, now: float,
                 stopped: bool, reach: float) -> Decision:
         self._travelled(episode, pose)
         episode.child_turning = False
@@ -327,7 +260,11 @@ class Avoidance:
         if v < 0.0 or (v == 0.0 and w == 0.0):  # backing away (from a stall), stopping: the monitor's to judge
             episode.clear_since = None
             return Decision(v, w, "detour", passed=True)
-        if v == 0.0 and self._goal_free(around, reach):  # turning to a goal nothing sensed is as near as: done
+        if episode.way is not None:
+            on_way = self._on_way(episode, (v, w), around, pose, now, stopped=stopped)
+            if on_way is not None:
+                return on_way
+        if v == 0.0 and around.goal_free(reach, enclosing_radius(self.avoid.footprint)):  # nothing as near: done
             return self._detour_done(episode, v, w, now, f"the goal {reach:.2f} m away, nothing nearer")
         if v > 0.0 and not stopped and not self._blocked(v, w, around, at_least=self._reach(v), reach=reach):
             episode.held_since = None
@@ -342,40 +279,114 @@ class Avoidance:
         if choice.direction is not None and not stopped and command != (0.0, 0.0):
             episode.held_since = None
         else:  # no direction will do, none that moves the robot, or the monitor stopped the last command: held
-            episode.held_since = now if episode.held_since is None else episode.held_since
-            held = now - episode.held_since
-            backing = self._start_back(episode, choice, around, pose, now, timed_out=held >= self.settings.timeout) \
-                if held >= self.settings.wait else None
-            if backing is not None:
-                return backing
-            if held >= self.settings.timeout:
-                return self._give_up(self._blocked_reason(held, v, w, around.points, choice), now)
+            held = self._detour_held(episode, (v, w), choice, around, pose, now)
+            if held is not None:
+                return held
         episode.side = episode.side or choice.side
         return Decision(*command, "detour", choice)
 
-    def _goal_free(self, around: Surroundings, reach: float) -> bool:
-        """Is every sensed point farther from the robot's centre than the goal is (``reach``) plus the
-        footprint's farthest corner? Then a straight drive to the goal, in whatever direction it lies,
-        touches nothing: no detour is needed to get there (the goal may lie nearer something than the
-        clearance, as a wish's goal may; the wish after the turn is judged with the clearance)."""
-        if not math.isfinite(reach):
-            return False
-        nearest = float(np.min(np.hypot(*around.points.T))) if len(around.points) else math.inf
-        return nearest > reach + enclosing_radius(self.avoid.footprint)
+    def _detour_held(self, episode: Episode, wish: tuple[float, float], choice: Choice, around: Surroundings,
+                     pose: Pose2D, now: float) -> Decision | None:
+        """A detour held with no direction: after ``wait``, a way round planned, or backing away; after
+        ``timeout``, giving up. None: held on."""
+        episode.held_since = now if episode.held_since is None else episode.held_since
+        held = now - episode.held_since
+        if held >= self.settings.wait:
+            if self._planned(episode, held, choice, wish, pose, now):
+                return self._way_begun(episode, wish, around, pose, now, f"no direction will do after {held:.1f} s")
+            backing = self._start_back(episode, choice, around, pose, now, timed_out=held >= self.settings.timeout)
+            if backing is not None:
+                return backing
+        if held >= self.settings.timeout:
+            return self._give_up(self._blocked_reason(held, *wish, around.points, choice), now)
+        return None
 
-    def _detour_done(self, episode: _Episode, v: float, w: float, now: float, why: str) -> Decision:
+    def _start_detour(self, episode: Episode, pose: Pose2D, now: float, side: int) -> None:
+        """A wait turns into a detour."""
+        self._end_wait(episode, now, cleared=False)
+        episode.detour_start, episode.last, episode.side = now, pose, side
+        self.phase = "detour"
+        self.tally.detours += 1
+
+    def _planned(self, episode: Episode, held: float, choice: Choice, wish: tuple[float, float], pose: Pose2D,
+                 now: float) -> bool:
+        """Held ``held`` s with no direction: is a way round planned (module docstring)?"""
+        return not choice.only_straying and held >= self.settings.wait + SETTLE and \
+            self._plan_way(episode, *wish, pose, now)
+
+    def _plan_way(self, episode: Episode, v: float, w: float, pose: Pose2D, now: float) -> bool:
+        """Plan a way round past where the robot was first held, along where the wish headed then,
+        every :data:`REPLAN` s at most, :data:`WAY_LENGTH` detours long at most. True: ``episode.way``."""
+        echoes = self._echoes
+        if not self.settings.plan or echoes is None or now - episode.planned < REPLAN:
+            return False
+        episode.planned = now
+        if episode.way_from is None:
+            heading = episode.goal if episode.goal is not None else pose.theta + wished_direction(v, w, self.avoid)
+            episode.way_from = (pose.x, pose.y, heading)
+        x, y, heading = episode.way_from
+        way = plan(echoes, pose, heading, self.avoid, origin=(x, y), line=episode.line)
+        if way is None or way.length > WAY_LENGTH * self.settings.max_length:
+            return False
+        if episode.way is None:
+            self.tally.ways += 1
+            episode.way_start, episode.turned = episode.length, 0.0
+        if episode.held_since is None:  # a way planned from a wait: held since the hold began, until it moves
+            episode.held_since = episode.origin
+        episode.way = way
+        return True
+
+    def _way_begun(self, episode: Episode, wish: tuple[float, float], around: Surroundings, pose: Pose2D,
+                   now: float, why: str) -> Decision:
+        """The first tick along a way round just planned (``why``: what ended the detour without it)."""
+        way = episode.way
+        assert way is not None
+        event = f"{why}: a way round of {way.length:.2f} m"
+        return self._on_way(episode, wish, around, pose, now, stopped=False, event=event) or \
+            Decision(0.0, 0.0, "detour", event=event)
+
+    def _on_way(self, episode: Episode, wish: tuple[float, float], around: Surroundings, pose: Pose2D, now: float,
+                *, stopped: bool, event: str = "") -> Decision | None:
+        """A tick along the way round (:func:`maps.avoidance.wayround.along`); held, it is planned again
+        (:data:`REPLAN`), and dropped when there is none. None once it is driven or dropped: the detour
+        goes on as without it (the wish's own arc free does not end it: a pocket's mouth is free)."""
+        way = episode.way
+        assert way is not None
+        if way.driven(pose):
+            self._way_over(episode)
+            return None
+        command, choice = along(way, around, pose, self.avoid)
+        if not stopped and command != (0.0, 0.0):
+            episode.held_since = None
+            return Decision(*command, "detour", choice, event)
+        episode.held_since = now if episode.held_since is None else episode.held_since
+        held = now - episode.held_since
+        if held >= self.settings.timeout:
+            reason = self._blocked_reason(held, *wish, around.points, choice or Choice((), None, 0.0, 0.0))
+            return self._give_up(f"{reason}; the way round planned ({way.length:.2f} m) was not free", now)
+        if now - episode.planned < REPLAN or self._plan_way(episode, 0.0, 0.0, pose, now):
+            return Decision(0.0, 0.0, "detour", choice, event)
+        self._way_over(episode)
+        return None
+
+    def _way_over(self, episode: Episode) -> None:
+        """The way is driven or dropped; its turns are not the detour's (it went back round)."""
+        self.tally.way_length += episode.length - episode.way_start
+        episode.way, episode.turned = None, 0.0
+
+    def _detour_done(self, episode: Episode, v: float, w: float, now: float, why: str) -> Decision:
         """End a detour that did its work; the wish passes."""
         length, took = episode.length, now - (episode.detour_start or now)
         self._end_detour(episode, now)
         self.phase, self._episode = "clear", None
         return Decision(v, w, "clear", event=f"{why}: a detour of {length:.2f} m in {took:.1f} s", passed=True)
 
-    def _detour_over(self, episode: _Episode, pose: Pose2D, now: float) -> str:
+    def _detour_over(self, episode: Episode, pose: Pose2D, now: float) -> str:
         """Why a detour gives up now ("" while it goes on): too long, going round, or getting nowhere."""
-        if episode.length > self.settings.max_length:
+        if episode.length - episode.way_start > self.settings.max_length:
             return (f"a detour of {episode.length:.1f} m did not get past the obstacle "
                     f"(at most {self.settings.max_length:g} m)")
-        if self.settings.going_round and abs(episode.turned) > GOING_ROUND:
+        if self.settings.going_round and episode.way is None and abs(episode.turned) > GOING_ROUND:
             return (f"the detour turned {math.degrees(abs(episode.turned)):.0f} deg: it goes round the obstacle, "
                     "not past it")
         if episode.anchor is None or math.hypot(pose.x - episode.anchor[1].x, pose.y - episode.anchor[1].y) > PROGRESS:
@@ -384,7 +395,7 @@ class Avoidance:
             return f"the detour got nowhere for {now - episode.anchor[0]:.0f} s (within {PROGRESS:g} m)"
         return ""
 
-    def _start_back(self, episode: _Episode, choice: Choice, around: Surroundings, pose: Pose2D, now: float,
+    def _start_back(self, episode: Episode, choice: Choice, around: Surroundings, pose: Pose2D, now: float,
                     *, timed_out: bool = False) -> Decision | None:
         """No direction will do for the obstacles around: back away along the trail
         (:mod:`maps.avoidance.backoff`), if this hold has not done so :data:`BACKOFFS_PER_HOLD` times,
@@ -405,13 +416,13 @@ class Avoidance:
         if undo:  # the drive back has the hold's whole timeout; after it, only a wait (_back)
             episode.undoing, episode.undone, episode.held_since = True, True, now
         episode.backoffs += 1
-        self._backed_from = _HoldEnded(episode.origin, now, pose, episode.backoffs)
+        self._backed_from = HoldEnded(episode.origin, now, pose, episode.backoffs)
         self.phase = "backoff"
         self.tally.backoffs += 1
         away = math.hypot(target[0] - pose.x, target[1] - pose.y)
         return Decision(*command, "backoff", event=f"no way round: backing away {away:.2f} m the way it came")
 
-    def _back(self, episode: _Episode, around: Surroundings, pose: Pose2D, now: float) -> Decision | None:
+    def _back(self, episode: Episode, around: Surroundings, pose: Pose2D, now: float) -> Decision | None:
         """A tick of backing away; None once it is over (at the trail point, backed twice the distance,
         or the way back blocked): the phase it interrupted goes on from where the robot now stands."""
         assert episode.backing is not None
@@ -450,7 +461,7 @@ class Avoidance:
         near = math.hypot(pose.x - where.x, pose.y - where.y) <= self.avoid.max_stray
         return -side if near and now - when <= self.settings.timeout else 0
 
-    def _near_backoff(self, episode: _Episode, pose: Pose2D, now: float) -> None:
+    def _near_backoff(self, episode: Episode, pose: Pose2D, now: float) -> None:
         """A new hold soon (within ``timeout``) after a back-off, near where the robot backed away from:
         the same hold (its clock and its back-offs go on), so that driving back into the corner and
         backing away again cannot go on for ever."""
@@ -460,7 +471,7 @@ class Avoidance:
             episode.origin, episode.backoffs = min(episode.origin, record.origin), record.backoffs
 
     @staticmethod
-    def _travelled(episode: _Episode, pose: Pose2D) -> None:
+    def _travelled(episode: Episode, pose: Pose2D) -> None:
         """Add the motion since the last tick to the detour's length and turn, unless it was the motion
         node's own turn on the spot passed with ``pass_turns`` (a homing's measured turns to and from a
         sidestep would otherwise add up to the 180 degrees that give up)."""
@@ -491,11 +502,13 @@ class Avoidance:
             self._end_wait(episode, episode.clear_since, cleared=True)
             self._episode = None
 
-    def _end_wait(self, episode: _Episode, end: float, *, cleared: bool) -> None:
+    def _end_wait(self, episode: Episode, end: float, *, cleared: bool) -> None:
         self.tally.wait_time += end - episode.since
         self.tally.waits_cleared += int(cleared)
 
-    def _end_detour(self, episode: _Episode, now: float) -> None:
+    def _end_detour(self, episode: Episode, now: float) -> None:
+        if episode.way is not None:
+            self._way_over(episode)
         self.tally.detour_length += episode.length
         self.tally.detour_time += now - (episode.detour_start or now)
 
@@ -554,7 +567,7 @@ class Avoidance:
             reason += f"; no way around within {self.avoid.max_stray:g} m of the path"
         return reason
 
-    def _wish(self, episode: _Episode, v: float, w: float, pose: Pose2D) -> float:
+    def _wish(self, episode: Episode, v: float, w: float, pose: Pose2D) -> float:
         """Where the wish heads from the robot's heading now (rad). A forward command says it (eq. 4),
         and is remembered in the odometry frame; a turn on the spot says only which way, so the
         remembered heading stands for it (the turn's way while there is none), and the choice does
@@ -567,7 +580,7 @@ class Avoidance:
             episode.goal = pose.theta + wished_direction(v, w, self.avoid)
         return float(np.clip(wrap_angle(episode.goal - pose.theta), -self.avoid.spread, self.avoid.spread))
 
-    def _reach(self, v: float, episode: _Episode | None = None) -> float:
+    def _reach(self, v: float, episode: Episode | None = None) -> float:
         """How far a detour's direction must be free: as far as the detour's speed needs, or the wish's,
         the farther (a direction taken instead of the wish is free in the sense the wish was blocked);
         after a back-off, past where the robot was wedged (a direction ending there is no way out)."""

@@ -134,6 +134,16 @@ class Surroundings:
             free[_straight(self.footprint, self.near, psis) <= SWEEP_LENGTH] = 0.0
         return free
 
+    def goal_free(self, reach: float, radius: float) -> bool:
+        """Is every point farther from the robot's centre than the goal is (``reach``) plus ``radius``
+        (the footprint's farthest corner)? Then a straight drive to the goal, in whatever direction it
+        lies, touches nothing: no detour is needed to get there (the goal may lie nearer something than
+        the clearance, as a wish's goal may; the wish after the turn is judged with the clearance)."""
+        if not math.isfinite(reach):
+            return False
+        nearest = float(np.min(np.hypot(*self.points.T))) if len(self.points) else math.inf
+        return nearest > reach + radius
+
     def turns(self, psi: float) -> bool:
         """Can the footprint turn on the spot by ``psi`` (rad, left positive) without touching a point?
         (A disc always can.)"""

@@ -107,7 +107,7 @@ def travel_cost(
     weight[across[box]] = crossing
     node = np.full(sub.shape, -1, dtype=np.int64)
     node[sub] = np.arange(np.count_nonzero(sub))
-    graph = _grid_graph(sub, node, weight, frame.resolution)
+    graph = grid_graph(sub, node, weight, frame.resolution)
     dist, pred = dijkstra(graph, directed=False, indices=int(node[sr - r0, sc - c0]), return_predecessors=True)
     sub_rows, sub_cols = np.nonzero(sub)
     cost[sub_rows + r0, sub_cols + c0] = dist + snap
@@ -138,7 +138,7 @@ def _snap(
     return (int(wr[best] + r0), int(wc[best] + c0)), float(d[best])
 
 
-def _grid_graph(ok: np.ndarray, node: np.ndarray, weight: np.ndarray, res: float) -> coo_matrix:
+def grid_graph(ok: np.ndarray, node: np.ndarray, weight: np.ndarray, res: float) -> coo_matrix:
     """The 8-connected graph of the ``ok`` cells (undirected: each pair once): step length times the
     mean ``weight`` of its two cells."""
     heads, tails, weights = [], [], []

@@ -27,7 +27,7 @@ from perception.ranges import RangeScan
 
 RING = BODIES["p3dx"].sensors()
 PERSON_AHEAD = {3: 0.45, 4: 0.45}
-BOXED_IN = {i: 0.2 for i in range(8)}  # every front transducer 0.2 m from something
+BOXED_IN = {i: 0.2 for i in range(len(RING))}  # every transducer 0.2 m from something: no way round
 
 
 def scan(echoes: dict[int, float], stamp: float) -> RangeScan:
@@ -153,6 +153,25 @@ def test_it_tells_the_child_while_it_waits_for_the_way_to_clear_and_not_after():
     assert all(held[t] for t in held if t < 0.95)  # the wait
     assert not any(held[t] for t in held if t > 1.05)  # still held after it, with no way round: not told
     assert command(boxed) == (0.0, 0.0) and boxed.read("/robot/held") is False  # gave up
+
+
+def test_boxed_in_at_the_front_only_it_turns_to_a_way_round_behind_and_draws_it():
+    front = {i: 0.2 for i in range(8)}  # the front transducers 0.2 m from something, nothing heard behind
+    h = harness(front, wait=1.0)
+    h.tick_until(lambda s: h.behaviour.decision.phase == "detour", between=lambda h: sense(h, front))
+    v, w = command(h)
+    assert v == 0.0 and abs(w) == pytest.approx(math.radians(45.0))  # the way starts behind: turning to it
+    message = h.behaviour.feedback_message
+    assert message.startswith("no direction will do after ") and ": a way round of " in message
+    assert 2.0 <= float(message.split(" after ")[1].split(" s:")[0]) <= 2.1  # a second after the wait
+    way = [d for d in h.behaviour.drawings() if isinstance(d, Lines) and d.entity == "odometry_frame/avoidance/way"]
+    assert len(way) == 1 and len(way[0].strips) == 1 and way[0].strips[0][-1][0] >= 1.0  # a metre on (odometry)
+    figures = report_sections(h.behaviour)["avoidance"]["avoid"]
+    assert figures["ways"] == 1 and figures["give_ups"] == 0
+    off = harness(front, wait=1.0, timeout=3.0, plan=False)  # without planning: held until the timeout
+    assert off.tick_until(between=lambda h: sense(h, front)) == Status.FAILURE
+    assert off.clock.now() == pytest.approx(3.0, abs=0.11)
+    assert report_sections(off.behaviour)["avoidance"]["avoid"]["ways"] == 0
 
 
 def test_a_stop_of_the_collision_monitor_holds_the_child_too():

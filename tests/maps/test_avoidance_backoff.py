@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from maps.avoidance.backoff import BackoffSettings, Surroundings, Trail, back_command
-from maps.avoidance.detour import BACKOFFS_PER_HOLD, Avoidance, DetourSettings
+from maps.avoidance.detour import BACKOFFS_PER_HOLD, Avoidance
+from maps.avoidance.state import DetourSettings
 from maps.avoidance.sweep import AvoidSettings
 from perception.geometry import Pose2D, parent_to_frame
 from perception.polygons import disc

@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from maps.avoidance.detour import Avoidance, DetourSettings
+from maps.avoidance.detour import Avoidance
+from maps.avoidance.state import DetourSettings
 from maps.avoidance.sweep import AvoidSettings
 from perception.geometry import Pose2D
 from perception.polygons import disc
@@ -358,3 +359,40 @@ def test_a_wish_held_only_by_the_margin_beside_its_way_creeps_on():
     assert avoidance().step(0.3, 0.0, jambs, HERE, 0.0).passed  # straight through: nothing holds it
     in_the_way = avoidance().step(0.3, 0.0, np.vstack((jambs, [[0.62, 0.0]])), HERE, 0.0)
     assert (in_the_way.phase, in_the_way.v) == ("waiting", 0.0)
+
+
+def test_with_no_direction_within_a_right_angle_a_way_round_is_planned_on_the_echoes_kept():
+    # boxed in at the front (a half circle 0.45 m away): no direction within 90 degrees of the wish will do.
+    # A second after the wait (a walker gone is still in the last second's echoes) a way round is planned:
+    # the echoes kept show nothing behind, so it goes back and round. It starts behind the robot, beyond the
+    # fan's 120 degrees, so the robot first turns on the spot towards it.
+    a = avoidance(wait=2.0, plan=True)
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 0.0, echoes=BOXED_IN).phase == "waiting"
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 2.9, echoes=BOXED_IN).phase == "waiting"
+    turned = a.step(0.3, 0.0, BOXED_IN, HERE, 3.0, echoes=BOXED_IN)
+    assert turned.phase == "detour" and turned.event.startswith("no direction will do after 3.0 s: a way round of ")
+    assert turned.v == 0.0 and abs(turned.w) == pytest.approx(np.radians(45.0))
+    assert a.tally.ways == 1 and a.tally.detours == 1
+
+
+def test_without_the_echoes_kept_or_with_plan_off_no_way_round_is_planned():
+    for a, echoes in ((avoidance(wait=2.0, plan=True), None), (avoidance(wait=2.0), BOXED_IN)):
+        a.step(0.3, 0.0, BOXED_IN, HERE, 0.0, echoes=echoes)
+        held = a.step(0.3, 0.0, BOXED_IN, HERE, 3.0, echoes=echoes)
+        assert (held.phase, held.v, held.w, a.tally.ways) == ("waiting", 0.0, 0.0, 0)
+
+
+def test_held_on_a_way_round_until_the_timeout_gives_up_saying_so():
+    a = avoidance(wait=2.0, timeout=20.0, plan=True)
+    a.step(0.3, 0.0, BOXED_IN, HERE, 0.0, echoes=BOXED_IN)
+    decision = a.step(0.3, 0.0, BOXED_IN, HERE, 3.0, echoes=BOXED_IN)
+    assert a.tally.ways == 1
+    t = 3.0
+    while not decision.gave_up and t < 30.0:  # the collision monitor stops every command
+        t = round(t + 0.1, 1)
+        decision = a.step(0.3, 0.0, BOXED_IN, HERE, t, stopped=True, echoes=BOXED_IN)
+    # the way's first command (a turn, at 3.0 s) moved the robot; held from the next tick (3.1 s), 20 s on
+    assert t == pytest.approx(23.1)
+    assert decision.gave_up.startswith("blocked for 20 s by an obstacle 0.19 m ahead; the way round planned (")
+    assert decision.gave_up.endswith(" m) was not free") and a.tally.give_ups == 1
+
