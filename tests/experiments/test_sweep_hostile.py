@@ -32,7 +32,11 @@ def test_odd_rows_are_skipped_with_a_warning_and_huge_figures_summarised(tmp_pat
     ])
     with pytest.warns(UserWarning) as caught:
         rows = read_rows(tmp_path / "res" / "results.jsonl")
-    assert [r["id"] for r in rows] == ["a", "b"] and len(caught) == 5
+    # the reader's own warnings: pytest.warns records every warning raised in the block, and a garbage
+    # collection there (the deep row is a big allocation) can add another test's ResourceWarning
+    # (one CI run in many failed with 6)
+    ours = [w for w in caught if issubclass(w.category, UserWarning)]
+    assert [r["id"] for r in rows] == ["a", "b"] and len(ours) == 5, [str(w.message) for w in caught]
     [entry] = summarise(rows)
     assert entry["figures"]["x"] == {"n": 2, "mean": 1e308, "std": 0.0, "min": 1e308, "max": 1e308}
     assert main(["sweep", "--summary", str(tmp_path / "res"), "--figures", "x"]) == 0
