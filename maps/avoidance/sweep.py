@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -178,6 +179,13 @@ class DetourLine:
     def at(cls, pose: Pose2D) -> DetourLine:
         return cls(pose.x, pose.y, pose.theta)
 
-    def offset(self, x: float, y: float) -> float:
-        """Signed distance (m, left positive) of the odometry point (x, y) from the line (eq. 3)."""
+    @overload
+    def offset(self, x: float, y: float) -> float: ...
+
+    @overload
+    def offset(self, x: np.ndarray, y: np.ndarray) -> np.ndarray: ...
+
+    def offset(self, x: float | np.ndarray, y: float | np.ndarray) -> float | np.ndarray:
+        """Signed distance (m, left positive) of the odometry point (x, y) from the line (eq. 3); of
+        each point, given arrays."""
         return -(x - self.x) * math.sin(self.theta) + (y - self.y) * math.cos(self.theta)  # eq. 3

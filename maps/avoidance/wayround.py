@@ -45,7 +45,7 @@ from scipy.sparse.csgraph import dijkstra
 from maps.avoidance.directions import Choice, choose, steer
 from maps.avoidance.sweep import AvoidSettings, DetourLine, Surroundings
 from maps.exploration.grid import GridFrame
-from maps.exploration.travel import grid_graph
+from maps.exploration.travel import chain_to, grid_graph
 from perception.geometry import Pose2D, frame_to_parent, wrap_angle
 from perception.polygons import enclosing_radius
 
@@ -102,8 +102,7 @@ def plan(points: np.ndarray, pose: Pose2D, heading: float, settings: AvoidSettin
     ok = (room > need) | (near & (room >= min(radius, room[start_r, start_c])))
     if line is not None:
         here = abs(line.offset(pose.x, pose.y))
-        offsets = np.abs(-(odometry[:, 0] - line.x) * math.sin(line.theta) + (odometry[:, 1] - line.y)
-                         * math.cos(line.theta)).reshape(frame.shape)  # eq. 3
+        offsets = np.abs(line.offset(odometry[:, 0], odometry[:, 1])).reshape(frame.shape)
         ok &= (offsets <= max(stray * settings.max_stray, here)) | near
     ok[start_r, start_c] = True
     progress = ((odometry[:, 0] - origin[0]) * math.cos(heading)
@@ -120,11 +119,7 @@ def plan(points: np.ndarray, pose: Pose2D, heading: float, settings: AvoidSettin
     best = int(np.argmin(goal))
     if not math.isfinite(goal[best]):
         return None
-    chain = [best]
-    while previous[chain[-1]] >= 0:
-        chain.append(int(previous[chain[-1]]))
-    chain.reverse()
-    index = np.asarray(chain)
+    index = chain_to(previous, best)
     path = frame_to_parent(pose, frame.centre_of(ok_rows[index], ok_cols[index]))
     path[0] = (pose.x, pose.y)
     return WayRound(path, float(np.sum(np.hypot(*np.diff(path, axis=0).T))))

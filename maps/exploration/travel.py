@@ -46,12 +46,7 @@ class TravelCost:
         if not self.frame.inside(rows, cols)[0] or not np.isfinite(self.cost[rows[0], cols[0]]):
             return np.zeros((0, 2))
         flat = int(rows[0] * self.frame.cols + cols[0])
-        previous = self.previous.ravel()
-        chain = [flat]
-        while previous[chain[-1]] >= 0:
-            chain.append(int(previous[chain[-1]]))
-        chain.reverse()
-        r, c = np.divmod(np.asarray(chain), self.frame.cols)
+        r, c = np.divmod(chain_to(self.previous.ravel(), flat), self.frame.cols)
         return self.frame.centre_of(r, c)
 
 
@@ -136,6 +131,15 @@ def _snap(
     if d[best] > radius + frame.resolution:
         return None
     return (int(wr[best] + r0), int(wc[best] + c0)), float(d[best])
+
+
+def chain_to(previous: np.ndarray, end: int) -> np.ndarray:
+    """The indices from the start to ``end`` along a Dijkstra's predecessors (``previous``: -1 at the
+    start)."""
+    chain = [end]
+    while previous[chain[-1]] >= 0:
+        chain.append(int(previous[chain[-1]]))
+    return np.asarray(chain[::-1])
 
 
 def grid_graph(ok: np.ndarray, node: np.ndarray, weight: np.ndarray, res: float) -> coo_matrix:
