@@ -172,7 +172,7 @@ class AvoidObstacles(BearingsDecorator):
         safety = self.get_input(self.SAFETY, None)
         stopped = safety is not None and safety.state == "stopped"
         decision = self.avoidance.step(wish.v, wish.w, self.memory.around(pose, now), pose, now, stopped=stopped,
-                                       reach=wish.reach, echoes=self.echoes.around(pose) if planning else None)
+                                       reach=wish.reach, echoes=self.echoes if planning else None)
         self._record(decision, pose)
         # waiting, no way round judged yet (the fan is judged once the wait is over): the wait itself
         self.set_output(self.HELD, decision.phase == "waiting" and decision.choice is None)

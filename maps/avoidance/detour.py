@@ -107,6 +107,7 @@ from maps.avoidance.directions import Choice, choose, steer, wished_direction
 from maps.avoidance.state import Decision, DetourSettings, Episode, HoldEnded, Phase, Tally
 from maps.avoidance.sweep import AvoidSettings, DetourLine, Surroundings, free_distance, needed_distance
 from maps.avoidance.wayround import WayRound, along, plan
+from perception.echo_map import EchoMap
 from perception.geometry import Pose2D, wrap_angle
 from perception.polygons import distance, enclosing_radius
 
@@ -140,7 +141,7 @@ class Avoidance:
         self._cut: HoldEnded | None = None  # a hold that reset cut short
         self._failed: tuple[Pose2D, float, int] | None = None  # the last detour given up: (where, when, its side)
         self._creeping = False  # the last tick went on at the creep speed
-        self._echoes: np.ndarray | None = None  # this tick's echoes kept longer, with its points (base frame)
+        self._around: tuple[np.ndarray, EchoMap | None] = (np.zeros((0, 2)), None)  # this tick's points, echoes kept
 
     @property
     def line(self) -> DetourLine | None:
@@ -153,13 +154,13 @@ class Avoidance:
         return self._episode.way if self._episode is not None else None
 
     def step(self, v: float, w: float, points: np.ndarray, pose: Pose2D, now: float, *,
-             stopped: bool = False, reach: float = math.inf, echoes: np.ndarray | None = None) -> Decision:
+             stopped: bool = False, reach: float = math.inf, echoes: EchoMap | None = None) -> Decision:
         """The command for the wish ``(v, w)`` with ``points`` around the base (base frame), the
         robot at odometry ``pose``; ``stopped``: the collision monitor stopped the last command;
         ``reach``: how far the wish means to go before the node's goal (m; ``inf``: no goal in sight);
-        ``echoes``: the echoes kept longer (base frame, :mod:`perception.echo_map`), which a way round
-        is planned on (``plan``; None: none is)."""
-        self._echoes = None if echoes is None else np.vstack((points, echoes))
+        ``echoes``: the echoes kept longer (:mod:`perception.echo_map`), which a way round is planned
+        on, with ``points`` (``plan``; None: none is)."""
+        self._around = (points, echoes)
         creeping, self._creeping = self._creeping, False
         episode = self._episode
         if episode is not None and episode.backing is not None:
@@ -317,7 +318,7 @@ class Avoidance:
     def _plan_way(self, episode: Episode, v: float, w: float, pose: Pose2D, now: float) -> bool:
         """Plan a way round past where the robot was first held, along where the wish headed then,
         every :data:`REPLAN` s at most, :data:`WAY_LENGTH` detours long at most. True: ``episode.way``."""
-        echoes = self._echoes
+        points, echoes = self._around
         if not self.settings.plan or echoes is None or now - episode.planned < REPLAN:
             return False
         episode.planned = now
@@ -325,7 +326,8 @@ class Avoidance:
             heading = episode.goal if episode.goal is not None else pose.theta + wished_direction(v, w, self.avoid)
             episode.way_from = (pose.x, pose.y, heading)
         x, y, heading = episode.way_from
-        way = plan(echoes, pose, heading, self.avoid, origin=(x, y), line=episode.line)
+        way = plan(np.vstack((points, echoes.around(pose))), pose, heading, self.avoid, origin=(x, y),
+                   line=episode.line)
         if way is None or way.length > WAY_LENGTH * self.settings.max_length:
             return False
         if episode.way is None:

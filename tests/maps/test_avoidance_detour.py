@@ -13,6 +13,7 @@ import pytest
 from maps.avoidance.detour import Avoidance
 from maps.avoidance.state import DetourSettings
 from maps.avoidance.sweep import AvoidSettings
+from perception.echo_map import EchoMap
 from perception.geometry import Pose2D
 from perception.polygons import disc
 
@@ -20,6 +21,7 @@ NOTHING = np.zeros((0, 2))
 PERSON = np.array([[0.6, 0.0]])
 BOXED_IN = np.array([[0.45 * np.cos(a), 0.45 * np.sin(a)] for a in np.linspace(-np.pi / 2, np.pi / 2, 13)])
 HERE = Pose2D()
+KEPT = EchoMap(points=BOXED_IN, stamps=np.zeros(len(BOXED_IN)))  # the same echoes kept longer (HERE: odometry = base)
 
 
 def avoidance(**detour: float | bool) -> Avoidance:
@@ -367,16 +369,16 @@ def test_with_no_direction_within_a_right_angle_a_way_round_is_planned_on_the_ec
     # the echoes kept show nothing behind, so it goes back and round. It starts behind the robot, beyond the
     # fan's 120 degrees, so the robot first turns on the spot towards it.
     a = avoidance(wait=2.0, plan=True)
-    assert a.step(0.3, 0.0, BOXED_IN, HERE, 0.0, echoes=BOXED_IN).phase == "waiting"
-    assert a.step(0.3, 0.0, BOXED_IN, HERE, 2.9, echoes=BOXED_IN).phase == "waiting"
-    turned = a.step(0.3, 0.0, BOXED_IN, HERE, 3.0, echoes=BOXED_IN)
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 0.0, echoes=KEPT).phase == "waiting"
+    assert a.step(0.3, 0.0, BOXED_IN, HERE, 2.9, echoes=KEPT).phase == "waiting"
+    turned = a.step(0.3, 0.0, BOXED_IN, HERE, 3.0, echoes=KEPT)
     assert turned.phase == "detour" and turned.event.startswith("no direction will do after 3.0 s: a way round of ")
     assert turned.v == 0.0 and abs(turned.w) == pytest.approx(np.radians(45.0))
     assert a.tally.ways == 1 and a.tally.detours == 1
 
 
 def test_without_the_echoes_kept_or_with_plan_off_no_way_round_is_planned():
-    for a, echoes in ((avoidance(wait=2.0, plan=True), None), (avoidance(wait=2.0), BOXED_IN)):
+    for a, echoes in ((avoidance(wait=2.0, plan=True), None), (avoidance(wait=2.0), KEPT)):
         a.step(0.3, 0.0, BOXED_IN, HERE, 0.0, echoes=echoes)
         held = a.step(0.3, 0.0, BOXED_IN, HERE, 3.0, echoes=echoes)
         assert (held.phase, held.v, held.w, a.tally.ways) == ("waiting", 0.0, 0.0, 0)
@@ -384,13 +386,13 @@ def test_without_the_echoes_kept_or_with_plan_off_no_way_round_is_planned():
 
 def test_held_on_a_way_round_until_the_timeout_gives_up_saying_so():
     a = avoidance(wait=2.0, timeout=20.0, plan=True)
-    a.step(0.3, 0.0, BOXED_IN, HERE, 0.0, echoes=BOXED_IN)
-    decision = a.step(0.3, 0.0, BOXED_IN, HERE, 3.0, echoes=BOXED_IN)
+    a.step(0.3, 0.0, BOXED_IN, HERE, 0.0, echoes=KEPT)
+    decision = a.step(0.3, 0.0, BOXED_IN, HERE, 3.0, echoes=KEPT)
     assert a.tally.ways == 1
     t = 3.0
     while not decision.gave_up and t < 30.0:  # the collision monitor stops every command
         t = round(t + 0.1, 1)
-        decision = a.step(0.3, 0.0, BOXED_IN, HERE, t, stopped=True, echoes=BOXED_IN)
+        decision = a.step(0.3, 0.0, BOXED_IN, HERE, t, stopped=True, echoes=KEPT)
     # the way's first command (a turn, at 3.0 s) moved the robot; held from the next tick (3.1 s), 20 s on
     assert t == pytest.approx(23.1)
     assert decision.gave_up.startswith("blocked for 20 s by an obstacle 0.19 m ahead; the way round planned (")
