@@ -364,7 +364,7 @@ class Avoidance:
         episode.held_since = now if episode.held_since is None else episode.held_since
         held = now - episode.held_since
         if held >= self.settings.timeout:
-            reason = self._blocked_reason(held, *wish, around.points, choice or Choice((), None, 0.0, 0.0))
+            reason = self._blocked_reason(held, *wish, around.points, choice)
             return self._give_up(f"{reason}; the way round planned ({way.length:.2f} m) was not free", now)
         if now - episode.planned < REPLAN or self._plan_way(episode, 0.0, 0.0, pose, now):
             return Decision(0.0, 0.0, "detour", choice, event)
@@ -563,9 +563,9 @@ class Avoidance:
             return f"{along:.2f} m ahead"
         return f"{float(distance(self.avoid.footprint, points).min()):.2f} m away"
 
-    def _blocked_reason(self, held: float, v: float, w: float, points: np.ndarray, choice: Choice) -> str:
+    def _blocked_reason(self, held: float, v: float, w: float, points: np.ndarray, choice: Choice | None) -> str:
         reason = f"blocked for {held:.0f} s by an obstacle {self._ahead(v, w, points)}"
-        if choice.only_straying:
+        if choice is not None and choice.only_straying:
             reason += f"; no way around within {self.avoid.max_stray:g} m of the path"
         return reason
 

@@ -15,6 +15,8 @@ from maps.avoidance.wayround import WayRound
 from perception.geometry import Pose2D
 
 Phase = Literal["clear", "waiting", "detour", "backoff"]
+
+
 @dataclass(frozen=True, slots=True)
 class DetourSettings:
     """How long to wait, when to give up (:mod:`maps.avoidance.detour`)."""
