@@ -18,7 +18,7 @@ nothing.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -37,14 +37,8 @@ class EchoMap:
     than ``keep`` seconds and not seen through since."""
 
     keep: float = 20.0
-    points: np.ndarray = None  # type: ignore[assignment]  # set in __post_init__
-    stamps: np.ndarray = None  # type: ignore[assignment]
-
-    def __post_init__(self) -> None:
-        if self.points is None:
-            object.__setattr__(self, "points", np.zeros((0, 2)))
-        if self.stamps is None:
-            object.__setattr__(self, "stamps", np.zeros(0))
+    points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    stamps: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def added(self, scan: RangeScan, pose: Pose2D) -> EchoMap:
         """With ``scan`` (taken at odometry ``pose``) added: what its echoes see through is dropped,
